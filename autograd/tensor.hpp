@@ -1,0 +1,179 @@
+// Reverse-mode automatic differentiation, the core: a Tensor is a handle to a Node in a
+// graph; every op creates a new Node holding its value, its parents and a closure that
+// pushes the output gradient back into the parents' gradients. backward() runs those
+// closures in reverse topological order (micrograd, with dense arrays instead of scalars).
+//
+// Scalars: float, double, std::complex<float>, std::complex<double>. Storage is one
+// contiguous row-major array; most ops work on 2-D tensors (rows x cols), conv/pool on
+// 4-D N x C x H x W.
+//
+// Complex gradients follow the convention of PyTorch: for a real loss L and a complex
+// tensor z = a + ib, grad(z) = dL/da + i dL/db. Hence for a holomorphic y = f(z),
+// grad(z) = conj(f'(z)) * grad(y).
+#pragma once
+
+#include <Eigen/Core>
+#include <complex>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace ag {
+
+using Shape = std::vector<int64_t>;
+using Index = std::vector<int64_t>;  // row indices for gather / scatter
+
+std::string shape_str(const Shape& s);
+int64_t numel_of(const Shape& s);
+
+// Thrown for every misuse: wrong shapes, bad indices, backward from a non-scalar, ...
+struct Error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+template <class T> struct is_complex : std::false_type {};
+template <class T> struct is_complex<std::complex<T>> : std::true_type {};
+template <class T> inline constexpr bool is_complex_v = is_complex<T>::value;
+
+template <class T> struct real_of { using type = T; };
+template <class T> struct real_of<std::complex<T>> { using type = T; };
+template <class T> using real_t = typename real_of<T>::type;
+
+template <class T>
+using RowMat = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+template <class T> using MatMap = Eigen::Map<RowMat<T>>;
+template <class T> using ConstMatMap = Eigen::Map<const RowMat<T>>;
+
+// ---- grad mode -------------------------------------------------------------------------
+bool grad_enabled();
+// Inference scope: ops inside record no graph. RAII, nests, per thread.
+class NoGradGuard {
+ public:
+  NoGradGuard();
+  ~NoGradGuard();
+  NoGradGuard(const NoGradGuard&) = delete;
+  NoGradGuard& operator=(const NoGradGuard&) = delete;
+
+ private:
+  bool previous_;
+};
+
+// ---- graph nodes -----------------------------------------------------------------------
+struct NodeBase {
+  virtual ~NodeBase() = default;
+  bool requires_grad = false;
+  std::vector<std::shared_ptr<NodeBase>> parents;
+  std::function<void()> backward_fn;  // reads this node's grad, adds into parents' grads
+  virtual void zero_grad() = 0;
+  virtual void seed_grad_one() = 0;  // grad := 1 (scalar root)
+  virtual int64_t numel() const = 0;
+};
+
+template <class T> struct Node final : NodeBase {
+  Shape shape;
+  std::vector<T> value;
+  std::vector<T> grad;  // empty until something flows in; then same size as value
+
+  void ensure_grad() {
+    if (grad.empty()) grad.assign(value.size(), T(0));
+  }
+  void zero_grad() override { grad.clear(); }
+  void seed_grad_one() override { grad.assign(value.size(), T(1)); }
+  int64_t numel() const override { return static_cast<int64_t>(value.size()); }
+};
+
+// Run reverse mode from `root` (which must hold exactly one element). Leaves keep their
+// gradients; intermediates are released afterwards unless retain_graph is true.
+void backward_from(const std::shared_ptr<NodeBase>& root, bool retain_graph = false);
+
+// ---- the tensor handle -------------------------------------------------------------------
+template <class T> class Tensor {
+ public:
+  using Scalar = T;
+
+  Tensor() = default;
+  explicit Tensor(std::shared_ptr<Node<T>> n) : n_(std::move(n)) {}
+
+  // Construction. `requires_grad` marks a leaf (parameter or input to differentiate).
+  static Tensor zeros(const Shape& shape, bool requires_grad = false);
+  static Tensor full(const Shape& shape, T v, bool requires_grad = false);
+  static Tensor from(const Shape& shape, std::vector<T> values, bool requires_grad = false);
+  static Tensor scalar(T v, bool requires_grad = false) { return full({1, 1}, v, requires_grad); }
+  // A 2-D tensor copied from an Eigen matrix expression (any storage order).
+  template <class Derived>
+  static Tensor from_eigen(const Eigen::MatrixBase<Derived>& m, bool requires_grad = false) {
+    Tensor t = zeros({m.rows(), m.cols()}, requires_grad);
+    t.mat() = m;
+    return t;
+  }
+
+  bool defined() const { return static_cast<bool>(n_); }
+  const Shape& shape() const { return node().shape; }
+  int64_t dim() const { return static_cast<int64_t>(node().shape.size()); }
+  int64_t size(int64_t d) const;
+  int64_t rows() const;  // 2-D only
+  int64_t cols() const;  // 2-D only
+  int64_t numel() const { return static_cast<int64_t>(node().value.size()); }
+
+  T* data() { return node().value.data(); }
+  const T* data() const { return node().value.data(); }
+  std::vector<T>& values() { return node().value; }
+  const std::vector<T>& values() const { return node().value; }
+  T item() const;  // the single element of a one-element tensor
+  T at(int64_t r, int64_t c) const { return data()[r * cols() + c]; }
+
+  MatMap<T> mat();  // 2-D view as an Eigen row-major matrix
+  ConstMatMap<T> mat() const;
+
+  // Gradients (leaves, or retained intermediates). Empty if nothing flowed in.
+  const std::vector<T>& grad() const { return node().grad; }
+  bool has_grad() const { return !node().grad.empty(); }
+  ConstMatMap<T> grad_mat() const;
+  void zero_grad() { node().zero_grad(); }
+
+  bool requires_grad() const { return node().requires_grad; }
+  Tensor& set_requires_grad(bool on);
+
+  // d(this)/d(leaves); this must be a one-element tensor.
+  void backward(bool retain_graph = false) const { backward_from(n_, retain_graph); }
+  // A new leaf with the same values and no history.
+  Tensor detach() const;
+  Tensor clone() const { return detach(); }
+
+  Node<T>& node() const {
+    if (!n_) throw Error("use of an undefined tensor");
+    return *n_;
+  }
+  const std::shared_ptr<Node<T>>& node_ptr() const { return n_; }
+
+ private:
+  std::shared_ptr<Node<T>> n_;
+};
+
+using Tensorf = Tensor<float>;
+using Tensord = Tensor<double>;
+using Tensorcf = Tensor<std::complex<float>>;
+using Tensorcd = Tensor<std::complex<double>>;
+
+// ---- helpers every op uses ------------------------------------------------------------------
+// A fresh output tensor (no history yet) with the given shape, zero-filled.
+template <class T> Tensor<T> new_output(const Shape& shape) { return Tensor<T>::zeros(shape); }
+
+// Attach history to an op's output: if grad mode is on and any parent requires grad, the
+// output requires grad, keeps its parents alive and stores `fn` as its backward. `fn`
+// should capture raw Node pointers (parents are kept alive by `parents`).
+void record(NodeBase& out, std::vector<std::shared_ptr<NodeBase>> parents,
+            std::function<void()> fn);
+
+// Rows processed per OpenMP chunk are large enough to amortise thread start-up.
+inline constexpr int64_t kParallelMin = 16384;
+
+// Shape checks with messages naming the op and both shapes.
+void check_same_shape(const char* op, const Shape& a, const Shape& b);
+void check_2d(const char* op, const Shape& a);
+
+}  // namespace ag
