@@ -1,0 +1,103 @@
+#include "autograd/gradcheck.hpp"
+
+#include "autograd/ops_elementwise.hpp"
+#include "autograd/ops_reduce.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <sstream>
+
+namespace ag {
+
+std::string GradCheckResult::report() const {
+  std::ostringstream o;
+  o.precision(6);
+  o << "gradcheck: worst relative error " << max_rel_error << " at input " << input << " element " << element
+    << " (analytic " << analytic << ", numeric " << numeric << "), " << checked << " entries checked";
+  return o.str();
+}
+
+GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>&)>& f,
+                          std::vector<Tensord> inputs, const GradCheckOptions& opt) {
+  std::mt19937_64 rng(opt.seed);
+  for (auto& x : inputs) {
+    if (x.node().backward_fn) throw Error("gradcheck: inputs must be leaves");
+    x.zero_grad();
+    x.set_requires_grad(true);
+  }
+
+  // Fixed random output weights: L = sum(w * f(inputs)).
+  Tensord probe;
+  {
+    NoGradGuard ng;
+    probe = f(inputs);
+  }
+  std::uniform_real_distribution<double> uw(0.5, 1.5);
+  std::vector<double> w(static_cast<size_t>(probe.numel()));
+  for (double& v : w) v = (rng() & 1 ? 1.0 : -1.0) * uw(rng);
+  const Tensord weights = Tensord::from(probe.shape(), w);
+
+  auto loss_value = [&]() {
+    NoGradGuard ng;
+    const Tensord y = f(inputs);
+    if (y.numel() != static_cast<int64_t>(w.size())) throw Error("gradcheck: output size changed between calls");
+    double s = 0;
+    for (size_t i = 0; i < w.size(); ++i) s += w[i] * y.data()[i];
+    return s;
+  };
+
+  // Analytic gradients.
+  {
+    const Tensord y = f(inputs);
+    if (!y.requires_grad()) throw Error("gradcheck: the output does not depend on any input");
+    sum(mul(y, weights)).backward();
+  }
+
+  GradCheckResult res;
+  for (size_t k = 0; k < inputs.size(); ++k) {
+    Tensord& x = inputs[k];
+    const int64_t n = x.numel();
+    std::vector<int64_t> entries(static_cast<size_t>(n));
+    std::iota(entries.begin(), entries.end(), 0);
+    if (n > opt.max_entries_per_input) {
+      std::shuffle(entries.begin(), entries.end(), rng);
+      entries.resize(static_cast<size_t>(opt.max_entries_per_input));
+    }
+    const std::vector<double> analytic =
+        x.has_grad() ? x.grad() : std::vector<double>(static_cast<size_t>(n), 0.0);
+
+    std::vector<double> numeric(entries.size());
+    for (size_t e = 0; e < entries.size(); ++e) {
+      double& v = x.values()[static_cast<size_t>(entries[e])];
+      const double orig = v;
+      const double h = opt.step * std::max(1.0, std::abs(orig));
+      v = orig + h;
+      const double lp = loss_value();
+      v = orig - h;
+      const double lm = loss_value();
+      v = orig;
+      numeric[e] = (lp - lm) / (2 * h);
+    }
+    double largest = 0;
+    for (double v : numeric) largest = std::max(largest, std::abs(v));
+    const double floor = opt.floor_fraction * largest + 1e-12;
+    for (size_t e = 0; e < entries.size(); ++e) {
+      const double a = analytic[static_cast<size_t>(entries[e])], nu = numeric[e];
+      double rel = std::abs(a - nu) / std::max({std::abs(a), std::abs(nu), floor});
+      if (std::isnan(rel)) rel = INFINITY;  // a NaN gradient is the worst error
+      if (res.input < 0 || rel > res.max_rel_error) {
+        res.max_rel_error = rel;
+        res.input = static_cast<int>(k);
+        res.element = entries[e];
+        res.analytic = a;
+        res.numeric = nu;
+      }
+      ++res.checked;
+    }
+  }
+  return res;
+}
+
+}  // namespace ag

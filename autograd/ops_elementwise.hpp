@@ -1,0 +1,46 @@
+// Elementwise ops. Binary ops broadcast over 2-D tensors (rows x cols): each operand
+// dimension must equal the result's or be 1 ([R x C] op [1 x C] is a row broadcast,
+// [R x 1] a column broadcast, [1 x 1] a scalar). Tensors of other ranks must have equal
+// shapes (or one element). Backward sums the gradient over broadcast dimensions.
+#pragma once
+
+#include "autograd/tensor.hpp"
+
+namespace ag {
+
+// Any scalar type (float, double, complex<float>, complex<double>).
+template <class T> Tensor<T> add(const Tensor<T>& a, const Tensor<T>& b);
+template <class T> Tensor<T> sub(const Tensor<T>& a, const Tensor<T>& b);
+template <class T> Tensor<T> mul(const Tensor<T>& a, const Tensor<T>& b);
+template <class T> Tensor<T> div(const Tensor<T>& a, const Tensor<T>& b);
+template <class T> Tensor<T> neg(const Tensor<T>& a);
+template <class T> Tensor<T> add_scalar(const Tensor<T>& a, T s);
+template <class T> Tensor<T> mul_scalar(const Tensor<T>& a, T s);
+
+template <class T> Tensor<T> operator+(const Tensor<T>& a, const Tensor<T>& b) { return add(a, b); }
+template <class T> Tensor<T> operator-(const Tensor<T>& a, const Tensor<T>& b) { return sub(a, b); }
+template <class T> Tensor<T> operator*(const Tensor<T>& a, const Tensor<T>& b) { return mul(a, b); }
+template <class T> Tensor<T> operator/(const Tensor<T>& a, const Tensor<T>& b) { return div(a, b); }
+template <class T> Tensor<T> operator-(const Tensor<T>& a) { return neg(a); }
+template <class T> Tensor<T> operator+(const Tensor<T>& a, T s) { return add_scalar(a, s); }
+template <class T> Tensor<T> operator-(const Tensor<T>& a, T s) { return add_scalar(a, T(-s)); }
+template <class T> Tensor<T> operator*(const Tensor<T>& a, T s) { return mul_scalar(a, s); }
+template <class T> Tensor<T> operator*(T s, const Tensor<T>& a) { return mul_scalar(a, s); }
+
+// Real scalar types only (float, double).
+template <class T> Tensor<T> exp(const Tensor<T>& x);
+template <class T> Tensor<T> log(const Tensor<T>& x);
+template <class T> Tensor<T> sqrt(const Tensor<T>& x);  // gradient at 0 is +inf; add an eps first
+template <class T> Tensor<T> sin(const Tensor<T>& x);
+template <class T> Tensor<T> cos(const Tensor<T>& x);
+template <class T> Tensor<T> tanh(const Tensor<T>& x);
+template <class T> Tensor<T> abs(const Tensor<T>& x);  // d|x|/dx at 0 taken as 0
+template <class T> Tensor<T> square(const Tensor<T>& x);
+template <class T> Tensor<T> pow(const Tensor<T>& x, T p);  // x^p; for non-integer p needs x > 0
+template <class T> Tensor<T> relu(const Tensor<T>& x);
+template <class T> Tensor<T> leaky_relu(const Tensor<T>& x, T slope);
+template <class T> Tensor<T> sigmoid(const Tensor<T>& x);
+template <class T> Tensor<T> clamp(const Tensor<T>& x, T lo, T hi);  // gradient 0 outside [lo, hi]
+template <class T> Tensor<T> atan2(const Tensor<T>& y, const Tensor<T>& x);  // same shapes; grad at (0,0) taken as 0
+
+}  // namespace ag

@@ -1,0 +1,12 @@
+// Losses between a prediction and a target of the same shape, reduced by the mean over all
+// elements -> [1 x 1]. The target may or may not require grad.
+#pragma once
+
+#include "autograd/tensor.hpp"
+
+namespace ag {
+
+template <class T> Tensor<T> l1_loss(const Tensor<T>& pred, const Tensor<T>& target);  // mean |p - t|
+template <class T> Tensor<T> mse_loss(const Tensor<T>& pred, const Tensor<T>& target); // mean (p - t)^2
+
+}  // namespace ag

@@ -1,0 +1,15 @@
+// Reductions over a 2-D tensor [R x C]. (sum and mean accept any rank.)
+#pragma once
+
+#include "autograd/tensor.hpp"
+
+namespace ag {
+
+template <class T> Tensor<T> sum(const Tensor<T>& x);        // -> [1 x 1]
+template <class T> Tensor<T> mean(const Tensor<T>& x);       // -> [1 x 1]
+template <class T> Tensor<T> sum_rows(const Tensor<T>& x);   // per row, over columns -> [R x 1]
+template <class T> Tensor<T> mean_rows(const Tensor<T>& x);  // -> [R x 1]
+template <class T> Tensor<T> sum_cols(const Tensor<T>& x);   // per column, over rows -> [1 x C]
+template <class T> Tensor<T> mean_cols(const Tensor<T>& x);  // -> [1 x C]
+
+}  // namespace ag

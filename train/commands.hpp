@@ -1,0 +1,9 @@
+// Subcommands of the gdsr executable. Each command file defines one add_xxx_command that
+// registers its subcommand (and its callback) on the top-level app; main.cpp calls them.
+#pragma once
+
+namespace CLI {
+class App;
+}
+
+void add_data_command(CLI::App& app);  // train/cmd_data.cpp: gdsr data make|preview|import-md|check
