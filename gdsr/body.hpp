@@ -8,7 +8,8 @@
 //   CGAL's surface mesher: closed, manifold, outward normals) and skinned to the bones.
 //
 // Output coordinates: metres, y up. Every body is scaled uniformly so that its rest pose is
-// opt.height tall (y extent), and translated so that the rest pose stands on y = 0 with
+// opt.height tall (y extent; for skeleton bodies counting the legs as vertical, so a rest
+// pose with spread legs is a bit lower than opt.height), and translated so that the rest pose stands on y = 0 with
 // its bounding-box centre at x = z = 0; the same similarity transform is applied to all
 // frames, so root motion is kept. The file's UpAxis metadata (FBX) is honoured.
 //
@@ -52,7 +53,7 @@ struct BodySection {
 // For skeleton bodies waist/hip heights come from the torso construction; for skinned meshes
 // they are fixed fractions of the height (waist 0.61 H, hips 0.52 H).
 struct BodyLandmarks {
-  double height = 0;         // rest-pose y extent (== opt.height)
+  double height = 0;         // standing height (== opt.height), see above
   BodySection waist;         // narrowest part of the torso (skirt waistband)
   BodySection hips;          // widest part of the pelvis
   BodySection chest;         // chest/bust level (tops)

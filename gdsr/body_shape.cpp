@@ -8,6 +8,7 @@
 #include <CGAL/Complex_2_in_triangulation_3.h>
 #include <CGAL/IO/facets_in_complex_2_to_triangle_mesh.h>
 #include <CGAL/Implicit_surface_3.h>
+#include <CGAL/Random.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/Surface_mesh_default_triangulation_3.h>
 #include <CGAL/make_surface_mesh.h>
@@ -56,9 +57,9 @@ Part classify(const std::string& name) {
 // to the b-end), or an ellipsoid (a = centre, axes ex/ey/ez). Approximate distances.
 struct Prim {
   bool ellipsoid = false;
-  Vec3 a, b, ex, ey, ez;
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero(), ex = Vec3::UnitX(), ey = Vec3::UnitY(), ez = Vec3::UnitZ();
   double rax = 0, raz = 0, rbx = 0, rbz = 0;  // capsule
-  Vec3 r;                                     // ellipsoid semi-axes
+  Vec3 r = Vec3::Ones();                      // ellipsoid semi-axes
   int owner = -1;                             // node; -1 = torso (spine chain by height)
 
   double sdf(const Vec3& p) const {
@@ -177,6 +178,22 @@ SkinnedBody build_skeleton_body(const std::vector<SkelNode>& nodes_in, double mp
     out.hip_y = pel.c.y(), out.waist_y = wst.c.y(), out.chest_y = chs.c.y();
     out.hip_c = pel.c, out.waist_c = wst.c, out.chest_c = chs.c;
     out.shoulder_y = sh_mid.y();
+    // Straight-leg length vs its vertical extent at rest (hip joint -> first foot node).
+    double extra = 0;
+    int legs = 0;
+    for (int t : thighs) {
+      int k = t;
+      while (k >= 0 && part[k] != Part::Foot) {
+        int next = -1;
+        for (int c : children[k])
+          if (part[c] == Part::Thigh || part[c] == Part::Shin || part[c] == Part::Foot) next = c;
+        k = next;
+      }
+      if (k < 0) continue;
+      extra += (P[k] - P[t]).norm() - (P[t].y() - P[k].y());
+      ++legs;
+    }
+    if (legs > 0) out.leg_extra = std::max(0.0, extra / legs);
   }
 
   for (int i = 0; i < n; ++i) {
@@ -274,6 +291,9 @@ SkinnedBody build_skeleton_body(const std::vector<SkelNode>& nodes_in, double mp
   double R = 0;
   for (int i = 0; i < n; ++i) R = std::max(R, (P[i] - centre).norm());
   R += 0.3;
+  // The mesher's initial points come from CGAL's (time-seeded) default random: fix it so the
+  // same skeleton always gives the same body.
+  CGAL::get_default_random() = CGAL::Random(20241122);
   Tr tr;
   C2t3 c2t3(tr);
   Fn fn = [&](Point_3 q) { return FT(field(Vec3(q.x(), q.y(), q.z()))); };
@@ -356,6 +376,7 @@ SkinnedBody build_skeleton_body(const std::vector<SkelNode>& nodes_in, double mp
   out.waist_y = out.waist_y / mpu + origin.y();
   out.chest_y = out.chest_y / mpu + origin.y();
   out.shoulder_y = out.shoulder_y / mpu + origin.y();
+  out.leg_extra /= mpu;
   out.hip_c = to_file(out.hip_c), out.waist_c = to_file(out.waist_c), out.chest_c = to_file(out.chest_c);
   if (!torso_ok) {
     // Fractions of the height as a fallback.

@@ -24,6 +24,9 @@ struct SkinnedBody {
   // Landmarks, file units: heights and torso-axis centre (x, z) at that height.
   double waist_y = 0, hip_y = 0, chest_y = 0, shoulder_y = 0;
   Vec3 waist_c, hip_c, chest_c;
+  // How much taller the body stands with straight vertical legs than at the rest pose
+  // (rest poses with spread legs), file units.
+  double leg_extra = 0;
 };
 
 // metres_per_unit: scale of the file units (radii are in metres); edge: target triangle

@@ -82,7 +82,7 @@ Correspondence compute_correspondence(const GarmentMesh& lr, const GarmentMesh& 
 #pragma omp parallel for schedule(static)
   for (int i = 0; i < c.hr_vertices; ++i) {
     const double q[2] = {hr.UV(hr_first[i], 0), hr.UV(hr_first[i], 1)};
-    size_t idx = 0;
+    unsigned idx = 0;
     double d2 = 0;
     tree.knnSearch(q, 1, &idx, &d2);
     c.hr_nearest_lr[i] = lr.uv_to_vertex[idx];

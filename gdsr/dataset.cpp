@@ -93,7 +93,7 @@ void check_frames(const std::vector<Points3>& frames, int n, int T, const std::s
   for (size_t t = 0; t < frames.size(); ++t)
     if (frames[t].rows() != n)
       fail(what + ": frame " + std::to_string(t) + " has " + std::to_string(frames[t].rows()) + " vertices, expected " +
-           std::to_string(n));
+           std::to_string(n) + " (vertex count mismatch)");
   check_finite_frames(frames, what);
 }
 

@@ -8,7 +8,7 @@
 #include "gdsr/mesh.hpp"
 #include "gdsr/model_config.hpp"
 
-#include <random>
+#include "nn/rng.hpp"
 
 namespace gdsr {
 
@@ -49,7 +49,7 @@ template <class T> struct GraphFeatures {
 template <class T>
 GraphFeatures<T> compute_features(const GarmentGraph& g, const ag::Tensor<T>& C_t,
                                   const FrameInput& in, const ModelConfig& cfg,
-                                  std::mt19937_64* noise = nullptr);
+                                  nn::Rng* noise = nullptr);
 
 // Layer-edge features only (EL x 9) for given directed pairs.
 template <class T>

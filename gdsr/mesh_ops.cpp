@@ -1,5 +1,7 @@
 #include "gdsr/mesh_ops.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -53,8 +55,8 @@ Points3 face_normals(const Points3& V, const Faces& F) {
   Points3 N(F.rows(), 3);
   for (int f = 0; f < F.rows(); ++f) {
     Vec3 n = (row3(V, F(f, 1)) - row3(V, F(f, 0))).cross(row3(V, F(f, 2)) - row3(V, F(f, 0)));
-    double len = n.norm();
-    N.row(f) = len > 0 ? (n / len).transpose() : Vec3::Zero().transpose();
+    const double len = n.norm();
+    N.row(f) = (len > 0 ? Vec3(n / len) : Vec3::Zero()).transpose();
   }
   return N;
 }

@@ -7,9 +7,7 @@
 #include <CGAL/Delaunay_mesher_no_edge_refinement_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
-#include <CGAL/lloyd_optimize_mesh_2.h>
 
-#include <cstdio>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -83,6 +81,103 @@ int find_root(std::vector<int>& parent, int i) {
     i = parent[i];
   }
   return i;
+}
+
+
+// Constrained Delaunay triangulation of the outline (pre-split boundary points `bpts`,
+// closed polygon) plus interior points `inner`; returns the in-domain triangles with
+// indices into [bpts, inner] (boundary first), counter-clockwise, in a canonical order.
+std::vector<std::array<int, 3>> cdt_triangles(const std::vector<Vec2>& bpts,
+                                              const std::vector<Vec2>& inner,
+                                              const std::string& name) {
+  const int nb = static_cast<int>(bpts.size());
+  CDT cdt;
+  std::vector<CDT::Vertex_handle> vh(nb);
+  for (int k = 0; k < nb; ++k) {
+    vh[k] = cdt.insert(CDT::Point(bpts[k].x(), bpts[k].y()));
+    vh[k]->info().id = k;
+  }
+  for (int k = 0; k < nb; ++k) cdt.insert_constraint(vh[k], vh[(k + 1) % nb]);
+  if (static_cast<int>(cdt.number_of_vertices()) != nb)
+    fail("panel '" + name + "' has coincident boundary points");
+  for (size_t m = 0; m < inner.size(); ++m) {
+    auto v = cdt.insert(CDT::Point(inner[m].x(), inner[m].y()));
+    if (v->info().id >= 0) fail("panel '" + name + "': interior point hits another point");
+    v->info().id = nb + static_cast<int>(m);
+  }
+  if (static_cast<int>(cdt.number_of_vertices()) != nb + static_cast<int>(inner.size()))
+    fail("panel '" + name + "': interior point on the boundary");
+  // Inside = faces not reachable from the infinite face without crossing a constraint.
+  Mesher::mark_convex_hull(cdt);
+  std::vector<std::array<int, 3>> tris;
+  for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+    if (!f->is_in_domain()) continue;
+    std::array<int, 3> t{f->vertex(0)->info().id, f->vertex(1)->info().id, f->vertex(2)->info().id};
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+    tris.push_back(t);
+  }
+  std::sort(tris.begin(), tris.end());
+  return tris;
+}
+
+// Fills the panel with near-equilateral triangles of edge ~h: a hexagonal lattice of
+// spacing h clipped to the outline (points closer than 0.6 h to the boundary dropped),
+// then a few Jacobi Lloyd-type smoothing passes (each interior point moves to the
+// area-weighted centroid of its triangles; re-triangulated each pass). Everything is
+// ordered by construction, so the result is identical run to run.
+void triangulate_panel(const Panel& panel, const std::vector<Vec2>& bpts, double h,
+                       std::vector<Vec2>& pts, std::vector<std::array<int, 3>>& tris) {
+  const auto& o = panel.outline;
+  const int nb = static_cast<int>(bpts.size());
+  Vec2 lo = o[0], hi = o[0];
+  for (const auto& c : o) {
+    lo = lo.cwiseMin(c);
+    hi = hi.cwiseMax(c);
+  }
+  auto dist_boundary = [&](const Vec2& q) {
+    double best = 1e300;
+    for (size_t e = 0; e < o.size(); ++e) {
+      const Vec2 a = o[e], b = o[(e + 1) % o.size()];
+      const double t = std::clamp((q - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+      best = std::min(best, (a + t * (b - a) - q).norm());
+    }
+    return best;
+  };
+  std::vector<Vec2> inner;
+  const double dy = h * std::sqrt(3.0) / 2;
+  const int rows = static_cast<int>(std::ceil((hi.y() - lo.y()) / dy));
+  const int cols = static_cast<int>(std::ceil((hi.x() - lo.x()) / h)) + 1;
+  for (int j = 1; j < rows; ++j)
+    for (int i = 0; i <= cols; ++i) {
+      const Vec2 q(lo.x() + (i + (j % 2 ? 0.5 : 0.0)) * h, lo.y() + j * dy);
+      if (point_in_polygon(q, o) && dist_boundary(q) > 0.6 * h) inner.push_back(q);
+    }
+  tris = cdt_triangles(bpts, inner, panel.name);
+  for (int pass = 0; pass < 6 && !inner.empty(); ++pass) {
+    std::vector<Vec2> sum(inner.size(), Vec2::Zero());
+    std::vector<double> wsum(inner.size(), 0.0);
+    auto at = [&](int id) { return id < nb ? bpts[id] : inner[id - nb]; };
+    for (const auto& t : tris) {
+      const Vec2 a = at(t[0]), b = at(t[1]), c = at(t[2]);
+      const double area = 0.5 * std::abs(cross2(b - a, c - a));
+      const Vec2 cen = (a + b + c) / 3.0;
+      for (int k = 0; k < 3; ++k)
+        if (t[k] >= nb) {
+          sum[t[k] - nb] += area * cen;
+          wsum[t[k] - nb] += area;
+        }
+    }
+    std::vector<Vec2> moved = inner;
+    for (size_t m = 0; m < inner.size(); ++m) {
+      if (wsum[m] <= 0) continue;
+      const Vec2 q = sum[m] / wsum[m];
+      if (point_in_polygon(q, o) && dist_boundary(q) > 0.25 * h) moved[m] = q;
+    }
+    inner = moved;
+    tris = cdt_triangles(bpts, inner, panel.name);
+  }
+  pts = bpts;
+  pts.insert(pts.end(), inner.begin(), inner.end());
 }
 
 }  // namespace
@@ -186,88 +281,18 @@ PatternMesh mesh_pattern(const Pattern& p, double h) {
     }
     const int nb = static_cast<int>(bpts.size());
 
-    CDT cdt;
-    std::vector<CDT::Vertex_handle> vh(nb);
-    for (int k = 0; k < nb; ++k) {
-      vh[k] = cdt.insert(CDT::Point(bpts[k].x(), bpts[k].y()));
-      vh[k]->info().id = k;
-    }
-    for (int k = 0; k < nb; ++k) cdt.insert_constraint(vh[k], vh[(k + 1) % nb]);
-    if (static_cast<int>(cdt.number_of_vertices()) != nb)
-      fail("panel '" + p.panels[i].name + "' has coincident boundary points");
-
-    // Seeds mark everything outside the outline (reachable from the infinite face without
-    // crossing a constraint) as not to be meshed.
-    std::vector<CDT::Point> seeds;
-    {
-      std::map<CDT::Face_handle, bool> seen;
-      std::vector<CDT::Face_handle> stack{cdt.infinite_face()};
-      seen[cdt.infinite_face()] = true;
-      while (!stack.empty()) {
-        auto f = stack.back();
-        stack.pop_back();
-        if (!cdt.is_infinite(f)) seeds.push_back(CGAL::centroid(cdt.triangle(f)));
-        for (int k = 0; k < 3; ++k) {
-          if (cdt.is_constrained(CDT::Edge(f, k))) continue;
-          auto g = f->neighbor(k);
-          if (!seen.count(g)) {
-            seen[g] = true;
-            stack.push_back(g);
-          }
-        }
-      }
-    }
-    Mesher mesher(cdt);
-    mesher.set_seeds(seeds.begin(), seeds.end(), false);
-    // The size bound caps the longest edge; 1.35 h gives a mean edge close to h.
-    mesher.set_criteria(Criteria(0.125, 1.35 * h));
-    mesher.refine_mesh();
-    { int c=0; for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) c+=f->is_in_domain(); fprintf(stderr,"DBG seeds %zu faces %zu indomain %d\n", seeds.size(), (size_t)cdt.number_of_faces(), c);}
-    CGAL::lloyd_optimize_mesh_2(cdt, CGAL::parameters::max_iteration_number = 10,
-                                CGAL::parameters::seeds_begin = seeds.begin(),
-                                CGAL::parameters::seeds_end = seeds.end());
-
-    // Collect in-domain faces; boundary points first (fixed order), then interior points.
-    std::vector<int> local(nb, -1);
-    std::map<CDT::Vertex_handle, int> interior;
+    std::vector<Vec2> pts;
+    std::vector<std::array<int, 3>> tris;
+    triangulate_panel(p.panels[i], bpts, h, pts, tris);
     const int base = static_cast<int>(uv.size());
-    for (int k = 0; k < nb; ++k) {
-      local[k] = base + k;
-      uv.push_back(bpts[k]);
+    for (size_t k = 0; k < pts.size(); ++k) {
+      uv.push_back(pts[k]);
       pm.uv_panel.push_back(i);
-      pm.uv_boundary.push_back(bedge[k]);
+      pm.uv_boundary.push_back(static_cast<int>(k) < nb ? bedge[k] : -1);
     }
-    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-      if (!f->is_in_domain()) continue;
-      std::array<int, 3> tri;
-      for (int k = 0; k < 3; ++k) {
-        auto v = f->vertex(k);
-        if (v->info().id >= 0) {
-          tri[k] = local[v->info().id];
-        } else {
-          auto it = interior.find(v);
-          if (it == interior.end()) {
-            const int id = static_cast<int>(uv.size());
-            uv.emplace_back(v->point().x(), v->point().y());
-            pm.uv_panel.push_back(i);
-            pm.uv_boundary.push_back(-1);
-            it = interior.emplace(v, id).first;
-          }
-          tri[k] = it->second;
-        }
-      }
-      fuv.push_back(tri);
-    }
-    // Every Steiner point must lie strictly inside (no split of the pre-split boundary).
-    for (const auto& kv : interior) {
-      const Vec2 q(kv.first->point().x(), kv.first->point().y());
-      for (int e = 0; e < ne; ++e) {
-        const Vec2 a = o[e], b = o[(e + 1) % ne];
-        const double t = std::clamp((q - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
-        if ((a + t * (b - a) - q).norm() < 1e-9)
-          fail("mesher split the boundary of panel '" + p.panels[i].name + "'");
-      }
-    }
+    for (auto t : tris) fuv.push_back({base + t[0], base + t[1], base + t[2]});
+    std::vector<int> local(nb);
+    for (int k = 0; k < nb; ++k) local[k] = base + k;
     bindex[i].resize(ne);
     for (int e = 0; e < ne; ++e) {
       for (int k = 0; k <= nseg[i][e]; ++k)

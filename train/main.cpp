@@ -21,7 +21,11 @@ int fail(const std::string& msg) {
 int main(int argc, char** argv) {
   CLI::App app{"gdsr: neural garment dynamic super-resolution"};
   app.require_subcommand(1);
+  add_demo_command(app);
   add_data_command(app);
+  add_train_command(app);
+  add_infer_command(app);
+  add_eval_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,179 @@
+#include "autograd/ops_index.hpp"
+
+#include <algorithm>
+#include <string>
+
+namespace ag {
+namespace {
+
+template <class T> T conj_if(const T& v) {
+  if constexpr (is_complex_v<T>) return std::conj(v);
+  else return v;
+}
+
+void check_index(const char* op, const Index& index, int64_t bound, const Shape& x_shape) {
+  for (size_t i = 0; i < index.size(); ++i)
+    if (index[i] < 0 || index[i] >= bound)
+      throw Error(std::string(op) + ": index " + std::to_string(index[i]) + " at position " +
+                  std::to_string(i) + " outside [0, " + std::to_string(bound) + ") for " +
+                  shape_str(x_shape));
+}
+
+// rows[i] += src[i'] for every (i <- index), serial: several sources may hit one row.
+template <class T>
+void scatter_add_serial(T* dst, const T* src, const Index& index, int64_t C) {
+  const int64_t n = static_cast<int64_t>(index.size());
+  for (int64_t i = 0; i < n; ++i) {
+    T* d = dst + index[i] * C;
+    const T* s = src + i * C;
+    for (int64_t j = 0; j < C; ++j) d[j] += s[j];
+  }
+}
+
+}  // namespace
+
+// ---- index_select_rows (gather) -------------------------------------------------------------
+template <class T> Tensor<T> index_select_rows(const Tensor<T>& x, const Index& index) {
+  check_2d("index_select_rows", x.shape());
+  const int64_t R = x.rows(), C = x.cols(), N = static_cast<int64_t>(index.size());
+  check_index("index_select_rows", index, R, x.shape());
+  auto out = new_output<T>({N, C});
+  const T* s = x.data();
+  T* o = out.data();
+#pragma omp parallel for if (N * C > kParallelMin)
+  for (int64_t i = 0; i < N; ++i) std::copy(s + index[i] * C, s + (index[i] + 1) * C, o + i * C);
+  record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), index, C] {
+    if (!xn->requires_grad) return;
+    xn->ensure_grad();
+    scatter_add_serial(xn->grad.data(), on->grad.data(), index, C);
+  });
+  return out;
+}
+
+// ---- scatter_add_rows (segment sum) -----------------------------------------------------------
+template <class T>
+Tensor<T> scatter_add_rows(const Tensor<T>& x, const Index& index, int64_t num_rows) {
+  check_2d("scatter_add_rows", x.shape());
+  const int64_t N = x.rows(), C = x.cols();
+  if (static_cast<int64_t>(index.size()) != N)
+    throw Error("scatter_add_rows: " + std::to_string(index.size()) + " indices for " +
+                shape_str(x.shape()));
+  if (num_rows < 0) throw Error("scatter_add_rows: negative num_rows");
+  check_index("scatter_add_rows", index, num_rows, x.shape());
+  auto out = new_output<T>({num_rows, C});
+  scatter_add_serial(out.data(), x.data(), index, C);
+  record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), index, C, N] {
+    if (!xn->requires_grad) return;
+    xn->ensure_grad();
+    T* g = xn->grad.data();
+    const T* go = on->grad.data();
+#pragma omp parallel for if (N * C > kParallelMin)
+    for (int64_t i = 0; i < N; ++i) {
+      const T* s = go + index[i] * C;
+      for (int64_t j = 0; j < C; ++j) g[i * C + j] += s[j];
+    }
+  });
+  return out;
+}
+
+// ---- scatter_mean_rows --------------------------------------------------------------------------
+template <class T>
+Tensor<T> scatter_mean_rows(const Tensor<T>& x, const Index& index, int64_t num_rows) {
+  check_2d("scatter_mean_rows", x.shape());
+  const int64_t N = x.rows(), C = x.cols();
+  if (static_cast<int64_t>(index.size()) != N)
+    throw Error("scatter_mean_rows: " + std::to_string(index.size()) + " indices for " +
+                shape_str(x.shape()));
+  if (num_rows < 0) throw Error("scatter_mean_rows: negative num_rows");
+  check_index("scatter_mean_rows", index, num_rows, x.shape());
+  std::vector<real_t<T>> inv(static_cast<size_t>(num_rows), 0);
+  for (int64_t i : index) inv[i] += 1;
+  for (auto& v : inv) v = v > 0 ? real_t<T>(1) / v : real_t<T>(0);
+  auto out = new_output<T>({num_rows, C});
+  T* o = out.data();
+  scatter_add_serial(o, x.data(), index, C);
+#pragma omp parallel for if (num_rows * C > kParallelMin)
+  for (int64_t r = 0; r < num_rows; ++r)
+    for (int64_t j = 0; j < C; ++j) o[r * C + j] *= inv[r];
+  record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), index, inv, C, N] {
+    if (!xn->requires_grad) return;
+    xn->ensure_grad();
+    T* g = xn->grad.data();
+    const T* go = on->grad.data();
+#pragma omp parallel for if (N * C > kParallelMin)
+    for (int64_t i = 0; i < N; ++i) {
+      const T* s = go + index[i] * C;
+      const real_t<T> w = inv[index[i]];
+      for (int64_t j = 0; j < C; ++j) g[i * C + j] += w * s[j];
+    }
+  });
+  return out;
+}
+
+// ---- interpolate_rows ---------------------------------------------------------------------------
+template <class T>
+Tensor<T> interpolate_rows(const Tensor<T>& x, const Index& index, const Tensor<T>& weight) {
+  check_2d("interpolate_rows", x.shape());
+  check_2d("interpolate_rows", weight.shape());
+  const int64_t R = x.rows(), C = x.cols(), N = weight.rows(), K = weight.cols();
+  if (static_cast<int64_t>(index.size()) != N * K)
+    throw Error("interpolate_rows: " + std::to_string(index.size()) +
+                " indices for weight " + shape_str(weight.shape()) + " (need rows*cols)");
+  check_index("interpolate_rows", index, R, x.shape());
+  auto out = new_output<T>({N, C});
+  const T* xs = x.data();
+  const T* w = weight.data();
+  T* o = out.data();
+#pragma omp parallel for if (N * K * C > kParallelMin)
+  for (int64_t i = 0; i < N; ++i) {
+    T* oi = o + i * C;
+    for (int64_t k = 0; k < K; ++k) {
+      const T wk = w[i * K + k];
+      const T* s = xs + index[i * K + k] * C;
+      for (int64_t j = 0; j < C; ++j) oi[j] += wk * s[j];
+    }
+  }
+  record(out.node(), {x.node_ptr(), weight.node_ptr()},
+         [xn = &x.node(), wn = &weight.node(), on = &out.node(), index, N, K, C] {
+           const T* go = on->grad.data();
+           if (wn->requires_grad) {
+             wn->ensure_grad();
+             const T* xs = xn->value.data();
+             T* gw = wn->grad.data();
+             // d/dw[i,k] = <x[idx], g[i]> (conjugated on x for complex: grad = conj(x) g).
+#pragma omp parallel for if (N * K * C > kParallelMin)
+             for (int64_t i = 0; i < N; ++i)
+               for (int64_t k = 0; k < K; ++k) {
+                 const T* s = xs + index[i * K + k] * C;
+                 T acc(0);
+                 for (int64_t j = 0; j < C; ++j) acc += conj_if(s[j]) * go[i * C + j];
+                 gw[i * K + k] += acc;
+               }
+           }
+           if (xn->requires_grad) {
+             xn->ensure_grad();
+             const T* w = wn->value.data();
+             T* gx = xn->grad.data();
+             for (int64_t i = 0; i < N; ++i)
+               for (int64_t k = 0; k < K; ++k) {
+                 const T wk = conj_if(w[i * K + k]);
+                 T* d = gx + index[i * K + k] * C;
+                 for (int64_t j = 0; j < C; ++j) d[j] += wk * go[i * C + j];
+               }
+           }
+         });
+  return out;
+}
+
+#define AG_INSTANTIATE(T)                                                                 \
+  template Tensor<T> index_select_rows<T>(const Tensor<T>&, const Index&);                \
+  template Tensor<T> scatter_add_rows<T>(const Tensor<T>&, const Index&, int64_t);        \
+  template Tensor<T> scatter_mean_rows<T>(const Tensor<T>&, const Index&, int64_t);       \
+  template Tensor<T> interpolate_rows<T>(const Tensor<T>&, const Index&, const Tensor<T>&);
+AG_INSTANTIATE(float)
+AG_INSTANTIATE(double)
+AG_INSTANTIATE(std::complex<float>)
+AG_INSTANTIATE(std::complex<double>)
+#undef AG_INSTANTIATE
+
+}  // namespace ag

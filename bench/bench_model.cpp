@@ -1,0 +1,207 @@
+// GDSR network speed on a synthetic garment of the paper's size (35 x 35 = 1,225 LR
+// vertices, 121 x 121 = 14,641 HR vertices, one UV square): inference per frame (all HR
+// vertices, NoGradGuard) and a training step (forward on the HR vertices of 8 patches of
+// 80 x 80 pixels of a 1024 raster, L1 on C_hat and G, backward), per preset.
+// Counters: share of each block in the forward (features, H, E, A, field), the model's
+// GFLOP per call (multiply-adds x 2 of its linear maps, from the architecture) and GFLOP/s.
+#include <benchmark/benchmark.h>
+
+#include "autograd/autograd.hpp"
+#include "gdsr/correspondence.hpp"
+#include "gdsr/gdsr_model.hpp"
+#include "gdsr/model_config.hpp"
+#include "gdsr/model_geometry.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <string>
+
+using namespace gdsr;
+
+namespace {
+
+GarmentMesh grid(int n, double size) {
+  GarmentMesh g;
+  g.V.resize(n * n, 3);
+  g.UV.resize(n * n, 2);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const int v = i * n + j;
+      const double x = size * j / (n - 1), z = size * i / (n - 1);
+      g.V.row(v) << x, 0.02 * std::sin(9 * x) * std::cos(7 * z), z;
+      g.UV.row(v) << x, z;
+      g.uv_to_vertex.push_back(v);
+    }
+  g.F.resize(2 * (n - 1) * (n - 1), 3);
+  int f = 0;
+  for (int i = 0; i + 1 < n; ++i)
+    for (int j = 0; j + 1 < n; ++j) {
+      const int a = i * n + j, b = a + 1, c = a + n, d = c + 1;
+      g.F.row(f++) << a, c, b;
+      g.F.row(f++) << b, c, d;
+    }
+  g.FUV = g.F;
+  return g;
+}
+
+struct Scene {
+  GarmentMesh lr, hr;
+  Correspondence corr;
+  GarmentGraph graph;
+  FrameInput in;
+  HrRequest all, patches;
+  Points3 G_target;
+};
+
+const Scene& scene() {
+  static std::unique_ptr<Scene> s;
+  if (s) return *s;
+  s = std::make_unique<Scene>();
+  const double size = 1.0;  // 1 m square: LR edges ~29 mm, HR ~8 mm (PD30 / PD10-like)
+  s->lr = grid(35, size);
+  s->hr = grid(121, size);
+  s->corr = compute_correspondence(s->lr, s->hr);
+  s->graph = build_graph(s->lr);
+  s->in.C_t = s->lr.V;
+  s->in.C_tm1 = s->lr.V;
+  s->in.C_tm1.col(0).array() -= 0.003;
+  s->in.C_tm2 = s->in.C_tm1;
+  s->in.C_tm2.col(0).array() -= 0.002;
+  s->in.Chat_tm1 = s->in.C_tm1;
+  s->in.Chat_tm2 = s->in.C_tm2;
+  s->all = hr_request_all(s->corr);
+  // 8 patches of 80 x 80 raster pixels of 1024: HR vertices in 8 squares of 80/1024 of the side.
+  std::vector<int> verts;
+  const double w = 80.0 / 1024.0 * size;
+  for (int p = 0; p < 8; ++p) {
+    const double u0 = 0.05 + 0.11 * p, v0 = 0.1 + 0.09 * p;
+    for (int v = 0; v < s->hr.V.rows(); ++v)
+      if (s->hr.UV(v, 0) >= u0 && s->hr.UV(v, 0) < u0 + w && s->hr.UV(v, 1) >= v0 && s->hr.UV(v, 1) < v0 + w)
+        verts.push_back(v);
+  }
+  s->patches = hr_request_subset(s->corr, verts);
+  s->G_target = upsample(s->corr, s->lr.V);
+  return *s;
+}
+
+int64_t block_macs(int64_t i, int64_t o) { return i * o + o * o; }
+int64_t stack_macs(const std::vector<int64_t>& w) {
+  int64_t n = 0;
+  for (size_t k = 0; k + 1 < w.size(); ++k) n += block_macs(w[k], w[k + 1]);
+  return n;
+}
+
+// Multiply-adds of the linear maps (the dominant cost), split by block.
+struct Flops {
+  double h = 0, e = 0, a = 0, field = 0;
+  double total() const { return h + e + a + field; }
+};
+Flops model_flops(const ModelConfig& c, const GarmentGraph& g, int64_t faces_needed, int64_t samples) {
+  const int64_t V = g.num_vertices, E1 = g.ring1_size(), E2 = g.ring2_size(), L = c.latent();
+  const int64_t mid = c.node_encoder_pre.back();
+  Flops f;
+  f.h = double(V) * (stack_macs(c.node_encoder_pre) + mid * mid + stack_macs(c.node_encoder_post) +
+                     stack_macs(c.decoder)) +
+        double(E1) * stack_macs(c.edge_encoder) +
+        double(c.mp_steps) * (double(E1 + E2) * block_macs(3 * L, L) +
+                              double(V) * block_macs((c.layer_edge_mlps ? 4 : 3) * L, L));
+  f.e = double(g.num_faces()) * (stack_macs(c.e_widths) + c.e_widths.back() * 9);
+  f.a = double(faces_needed) * (stack_macs(c.a_widths) + 2 * c.a_widths.back() * c.field_params());
+  double per_sample = 0;
+  for (const auto& l : c.field_layers()) per_sample += (l.in == 3 ? 1.0 : 4.0) * double(l.in * l.out);
+  f.field = double(samples) * per_sample;
+  for (double* x : {&f.h, &f.e, &f.a, &f.field}) *x *= 2e-9;  // GFLOP
+  return f;
+}
+
+// configs/ of the source tree this file belongs to (bench/../configs/).
+std::string config_dir() {
+  std::string f = __FILE__;
+  f = f.substr(0, f.find_last_of('/'));
+  return f.substr(0, f.find_last_of('/') + 1) + "configs/";
+}
+
+std::map<std::string, std::shared_ptr<GDSR<float>>>& models() {
+  static std::map<std::string, std::shared_ptr<GDSR<float>>> m;
+  return m;
+}
+GDSR<float>& model(const std::string& preset) {
+  auto& m = models()[preset];
+  if (!m) m = std::make_shared<GDSR<float>>(load_model_config(config_dir() + preset + ".json"));
+  return *m;
+}
+
+void set_counters(benchmark::State& st, const GdsrTimings& t, int iters, const Flops& f, double seconds_per_iter) {
+  const double sum = t.features + t.h + t.e + t.a + t.field;
+  st.counters["features_%"] = 100 * t.features / sum;
+  st.counters["H_%"] = 100 * t.h / sum;
+  st.counters["E_%"] = 100 * t.e / sum;
+  st.counters["A_%"] = 100 * t.a / sum;
+  st.counters["field_%"] = 100 * t.field / sum;
+  st.counters["GFLOP"] = f.total();
+  st.counters["GFLOP/s"] = f.total() / seconds_per_iter;
+  (void)iters;
+}
+
+void BM_Inference(benchmark::State& st, const std::string& preset) {
+  const Scene& s = scene();
+  GDSR<float>& m = model(preset);
+  GdsrTimings t;
+  int iters = 0;
+  double secs = 0;
+  for (auto _ : st) {
+    ag::NoGradGuard ng;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto out = m.forward(s.graph, s.in, &s.all, nullptr, &t);
+    benchmark::DoNotOptimize(out.G.data());
+    secs += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ++iters;
+  }
+  const Flops f = model_flops(m.config(), s.graph, s.graph.num_faces(), s.all.size());
+  set_counters(st, t, iters, f, secs / iters);
+  st.counters["HR_vertices"] = s.all.size();
+}
+
+void BM_TrainStep(benchmark::State& st, const std::string& preset) {
+  const Scene& s = scene();
+  GDSR<float>& m = model(preset);
+  Points3 G_t(s.patches.size(), 3);
+  for (int i = 0; i < s.patches.size(); ++i) {
+    Eigen::RowVector3d p = Eigen::RowVector3d::Zero();
+    for (int k = 0; k < 3; ++k) p += s.patches.bary(i, k) * s.lr.V.row(s.lr.F(s.patches.tri[i], k));
+    G_t.row(i) = p;
+  }
+  const ag::Tensorf G_target = to_tensor<float>(G_t), C_target = to_tensor<float>(s.lr.V);
+  GdsrTimings t;
+  nn::Rng noise(1);
+  int iters = 0;
+  double secs = 0;
+  int64_t faces = 0;
+  for (auto _ : st) {
+    const auto t0 = std::chrono::steady_clock::now();
+    auto out = m.forward(s.graph, s.in, &s.patches, &noise, &t);
+    faces = static_cast<int64_t>(out.faces.size());
+    auto loss = ag::add(ag::l1_loss(out.C_hat, C_target), ag::l1_loss(out.G, G_target));
+    loss.backward();
+    m.zero_grad();
+    secs += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ++iters;
+  }
+  Flops f = model_flops(m.config(), s.graph, faces, s.patches.size());
+  f.h *= 3, f.e *= 3, f.a *= 3, f.field *= 3;  // backward ~ 2x forward
+  set_counters(st, t, iters, f, secs / iters);
+  st.counters["HR_samples"] = s.patches.size();
+  st.counters["LR_faces_A"] = static_cast<double>(faces);
+}
+
+}  // namespace
+
+BENCHMARK_CAPTURE(BM_Inference, tiny, std::string("tiny"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Inference, small, std::string("small"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Inference, paper, std::string("paper"))->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK_CAPTURE(BM_TrainStep, small, std::string("small"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_TrainStep, paper, std::string("paper"))->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+
+BENCHMARK_MAIN();

@@ -1,0 +1,499 @@
+#include "gdsr/body.hpp"
+
+#include "gdsr/body_shape.hpp"
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <stdexcept>
+
+namespace gdsr {
+namespace {
+
+using Mat4 = Eigen::Matrix4d;
+using Quat = Eigen::Quaterniond;
+
+[[noreturn]] void fail(const std::string& path, const std::string& msg) {
+  throw std::runtime_error("load_body_sequence: " + path + ": " + msg);
+}
+
+Mat4 to_eigen(const aiMatrix4x4& m) {
+  Mat4 r;
+  r << m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4, m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3, m.d4;
+  return r;
+}
+
+struct Trs {
+  Vec3 t = Vec3::Zero();
+  Quat r = Quat::Identity();
+  Vec3 s = Vec3::Ones();
+  Mat4 matrix() const {
+    Mat4 m = Mat4::Identity();
+    m.topLeftCorner<3, 3>() = r.toRotationMatrix() * s.asDiagonal();
+    m.topRightCorner<3, 1>() = t;
+    return m;
+  }
+};
+
+Trs decompose(const aiMatrix4x4& m) {
+  aiVector3D s, p;
+  aiQuaternion q;
+  m.Decompose(s, q, p);
+  Trs r;
+  r.t = Vec3(p.x, p.y, p.z);
+  r.r = Quat(q.w, q.x, q.y, q.z).normalized();
+  r.s = Vec3(s.x, s.y, s.z);
+  return r;
+}
+
+template <class Key>
+int bracket(const Key* keys, unsigned n, double tick) {  // last key with time <= tick
+  if (n == 0 || tick <= keys[0].mTime) return 0;
+  int lo = 0, hi = static_cast<int>(n) - 1;
+  if (tick >= keys[hi].mTime) return hi;
+  while (hi - lo > 1) {
+    const int mid = (lo + hi) / 2;
+    (keys[mid].mTime <= tick ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+template <class Key>
+double frac(const Key* keys, unsigned n, int i, double tick) {
+  if (i + 1 >= static_cast<int>(n)) return 0;
+  const double dt = keys[i + 1].mTime - keys[i].mTime;
+  return dt > 0 ? std::clamp((tick - keys[i].mTime) / dt, 0.0, 1.0) : 0.0;
+}
+
+Trs sample(const aiNodeAnim* ch, double tick, const Trs& rest) {
+  Trs r = rest;
+  if (ch->mNumPositionKeys > 0) {
+    const int i = bracket(ch->mPositionKeys, ch->mNumPositionKeys, tick);
+    const double a = frac(ch->mPositionKeys, ch->mNumPositionKeys, i, tick);
+    const auto& k0 = ch->mPositionKeys[i].mValue;
+    const auto& k1 = ch->mPositionKeys[std::min<int>(i + 1, ch->mNumPositionKeys - 1)].mValue;
+    r.t = (1 - a) * Vec3(k0.x, k0.y, k0.z) + a * Vec3(k1.x, k1.y, k1.z);
+  }
+  if (ch->mNumRotationKeys > 0) {
+    const int i = bracket(ch->mRotationKeys, ch->mNumRotationKeys, tick);
+    const double a = frac(ch->mRotationKeys, ch->mNumRotationKeys, i, tick);
+    const auto& k0 = ch->mRotationKeys[i].mValue;
+    const auto& k1 = ch->mRotationKeys[std::min<int>(i + 1, ch->mNumRotationKeys - 1)].mValue;
+    const Quat q0(k0.w, k0.x, k0.y, k0.z), q1(k1.w, k1.x, k1.y, k1.z);
+    r.r = q0.normalized().slerp(a, q1.normalized());
+  }
+  if (ch->mNumScalingKeys > 0) {
+    const int i = bracket(ch->mScalingKeys, ch->mNumScalingKeys, tick);
+    const double a = frac(ch->mScalingKeys, ch->mNumScalingKeys, i, tick);
+    const auto& k0 = ch->mScalingKeys[i].mValue;
+    const auto& k1 = ch->mScalingKeys[std::min<int>(i + 1, ch->mNumScalingKeys - 1)].mValue;
+    r.s = (1 - a) * Vec3(k0.x, k0.y, k0.z) + a * Vec3(k1.x, k1.y, k1.z);
+  }
+  return r;
+}
+
+// Scene nodes in parent-before-child order with their rest transforms and channels.
+struct Rig {
+  std::vector<const aiNode*> node;
+  std::vector<int> parent;
+  std::vector<Trs> rest;
+  std::vector<const aiNodeAnim*> channel;
+  std::map<std::string, int> index;
+  Mat4 pre = Mat4::Identity();  // up-axis fix applied above the root
+
+  // Global transforms for the given local transforms.
+  std::vector<Mat4> globals(const std::vector<Trs>& local) const {
+    std::vector<Mat4> G(node.size());
+    for (size_t i = 0; i < node.size(); ++i)
+      G[i] = (parent[i] < 0 ? pre : G[parent[i]]) * local[i].matrix();
+    return G;
+  }
+};
+
+Mat4 up_axis_fix(const aiScene* s) {
+  Mat4 m = Mat4::Identity();
+  if (!s->mMetaData) return m;
+  int up = 1, sign = 1;
+  if (!s->mMetaData->Get("UpAxis", up)) return m;
+  s->mMetaData->Get("UpAxisSign", sign);
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  if (up == 2) R = Eigen::AngleAxisd(-M_PI / 2, Vec3::UnitX()).toRotationMatrix();
+  else if (up == 0) R = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()).toRotationMatrix();
+  if (sign < 0) R = Eigen::AngleAxisd(M_PI, Vec3::UnitX()).toRotationMatrix() * R;
+  m.topLeftCorner<3, 3>() = R;
+  return m;
+}
+
+// Skinning: vertex v = sum_k w_k * (G[node_k] * bind_k) * p_v (p in the bind space).
+struct Skin {
+  Points3 P;                         // bind-space positions
+  std::vector<int> start, mat;       // per vertex influences into mats
+  std::vector<double> weight;
+  std::vector<int> mat_node;         // matrix -> node
+  std::vector<Mat4> mat_bind;        // matrix -> bind (offset) matrix
+  Faces F;
+
+  Points3 apply(const std::vector<Mat4>& G) const {
+    std::vector<Mat4> M(mat_node.size());
+    for (size_t m = 0; m < M.size(); ++m) M[m] = G[mat_node[m]] * mat_bind[m];
+    Points3 out(P.rows(), 3);
+    for (Eigen::Index i = 0; i < P.rows(); ++i) {
+      Eigen::Vector4d p(P(i, 0), P(i, 1), P(i, 2), 1.0), acc = Eigen::Vector4d::Zero();
+      for (int k = start[i]; k < start[i + 1]; ++k) acc += weight[k] * (M[mat[k]] * p);
+      out.row(i) = acc.head<3>().transpose();
+    }
+    return out;
+  }
+};
+
+void collect(const aiNode* n, int parent, Rig& rig) {
+  const int id = static_cast<int>(rig.node.size());
+  rig.node.push_back(n);
+  rig.parent.push_back(parent);
+  rig.rest.push_back(decompose(n->mTransformation));
+  rig.channel.push_back(nullptr);
+  rig.index[n->mName.C_Str()] = id;
+  for (unsigned c = 0; c < n->mNumChildren; ++c) collect(n->mChildren[c], id, rig);
+}
+
+// Skinned meshes of the file (all meshes; meshes without bones follow their node).
+Skin skin_from_meshes(const aiScene* s, const Rig& rig, const std::string& path) {
+  Skin sk;
+  std::vector<Vec3> P;
+  std::vector<std::vector<std::pair<int, double>>> infl;
+  std::vector<Eigen::Vector3i> tris;
+  std::map<std::string, int> bone_mat;
+  for (size_t ni = 0; ni < rig.node.size(); ++ni) {
+    const aiNode* nd = rig.node[ni];
+    for (unsigned mi = 0; mi < nd->mNumMeshes; ++mi) {
+      const aiMesh* m = s->mMeshes[nd->mMeshes[mi]];
+      const int base = static_cast<int>(P.size());
+      for (unsigned v = 0; v < m->mNumVertices; ++v) P.emplace_back(m->mVertices[v].x, m->mVertices[v].y, m->mVertices[v].z);
+      infl.resize(P.size());
+      for (unsigned b = 0; b < m->mNumBones; ++b) {
+        const aiBone* bone = m->mBones[b];
+        auto it = rig.index.find(bone->mName.C_Str());
+        if (it == rig.index.end()) fail(path, std::string("bone '") + bone->mName.C_Str() + "' has no node");
+        const int mat = static_cast<int>(sk.mat_node.size());
+        sk.mat_node.push_back(it->second);
+        sk.mat_bind.push_back(to_eigen(bone->mOffsetMatrix));
+        for (unsigned w = 0; w < bone->mNumWeights; ++w)
+          if (bone->mWeights[w].mWeight > 0)
+            infl[base + bone->mWeights[w].mVertexId].push_back({mat, bone->mWeights[w].mWeight});
+      }
+      // Vertices without weights follow the mesh's node rigidly.
+      const int rigid = static_cast<int>(sk.mat_node.size());
+      sk.mat_node.push_back(static_cast<int>(ni));
+      sk.mat_bind.push_back(Mat4::Identity());
+      for (unsigned v = 0; v < m->mNumVertices; ++v)
+        if (infl[base + v].empty()) infl[base + v].push_back({rigid, 1.0});
+      for (unsigned f = 0; f < m->mNumFaces; ++f)
+        if (m->mFaces[f].mNumIndices == 3)
+          tris.emplace_back(base + m->mFaces[f].mIndices[0], base + m->mFaces[f].mIndices[1], base + m->mFaces[f].mIndices[2]);
+    }
+  }
+  if (tris.empty()) fail(path, "skinned mesh has no triangles");
+  sk.P.resize(P.size(), 3);
+  sk.start.push_back(0);
+  for (size_t i = 0; i < P.size(); ++i) {
+    sk.P.row(i) = P[i].transpose();
+    double tot = 0;
+    for (auto& [m, w] : infl[i]) tot += w;
+    for (auto& [m, w] : infl[i]) sk.mat.push_back(m), sk.weight.push_back(w / tot);
+    sk.start.push_back(static_cast<int>(sk.mat.size()));
+  }
+  sk.F.resize(tris.size(), 3);
+  for (size_t f = 0; f < tris.size(); ++f) sk.F.row(f) = tris[f].transpose();
+  return sk;
+}
+
+// Welds vertices with identical rest positions (mesh seams split by normals/UVs).
+void weld(Skin& sk, const Points3& rest) {
+  std::map<std::array<double, 3>, int> seen;
+  std::vector<int> remap(rest.rows());
+  std::vector<int> keep;
+  for (Eigen::Index i = 0; i < rest.rows(); ++i) {
+    std::array<double, 3> key{std::round(rest(i, 0) * 1e6), std::round(rest(i, 1) * 1e6), std::round(rest(i, 2) * 1e6)};
+    auto [it, fresh] = seen.emplace(key, static_cast<int>(keep.size()));
+    if (fresh) keep.push_back(static_cast<int>(i));
+    remap[i] = it->second;
+  }
+  Skin w;
+  w.mat_node = sk.mat_node;
+  w.mat_bind = sk.mat_bind;
+  w.P.resize(keep.size(), 3);
+  w.start.push_back(0);
+  for (size_t j = 0; j < keep.size(); ++j) {
+    const int i = keep[j];
+    w.P.row(j) = sk.P.row(i);
+    for (int k = sk.start[i]; k < sk.start[i + 1]; ++k) w.mat.push_back(sk.mat[k]), w.weight.push_back(sk.weight[k]);
+    w.start.push_back(static_cast<int>(w.mat.size()));
+  }
+  std::vector<Eigen::Vector3i> tris;
+  for (Eigen::Index f = 0; f < sk.F.rows(); ++f) {
+    Eigen::Vector3i t(remap[sk.F(f, 0)], remap[sk.F(f, 1)], remap[sk.F(f, 2)]);
+    if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) tris.push_back(t);
+  }
+  w.F.resize(tris.size(), 3);
+  for (size_t f = 0; f < tris.size(); ++f) w.F.row(f) = tris[f].transpose();
+  sk = std::move(w);
+}
+
+double smoothstep(double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return x * x * (3 - 2 * x);
+}
+
+BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_only) {
+  if (!(opt.fps > 0) || !(opt.height > 0) || opt.rest_blend_frames < 0 || !(opt.start_seconds >= 0) ||
+      !(opt.body_edge > 0))
+    fail(path, "bad BodyOptions (fps, height, body_edge must be > 0, rest_blend_frames and start_seconds >= 0)");
+  if (!std::ifstream(path).good()) fail(path, "file not found or not readable");
+  Assimp::Importer imp;
+  const aiScene* s = imp.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                            aiProcess_LimitBoneWeights);
+  if (!s || !s->mRootNode) fail(path, std::string("assimp cannot read it: ") + imp.GetErrorString());
+  if (s->mNumAnimations == 0) fail(path, "file has no animation");
+  const aiAnimation* anim = s->mAnimations[0];
+  for (unsigned a = 1; a < s->mNumAnimations; ++a)
+    if (s->mAnimations[a]->mNumChannels > anim->mNumChannels) anim = s->mAnimations[a];
+  if (anim->mNumChannels == 0) fail(path, "animation has no channels");
+
+  Rig rig;
+  collect(s->mRootNode, -1, rig);
+  rig.pre = up_axis_fix(s);
+  for (unsigned c = 0; c < anim->mNumChannels; ++c) {
+    auto it = rig.index.find(anim->mChannels[c]->mNodeName.C_Str());
+    if (it != rig.index.end()) rig.channel[it->second] = anim->mChannels[c];
+  }
+
+  std::string ext = path.substr(path.find_last_of('.') + 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  bool skinned = false;
+  if (ext != "bvh")
+    for (unsigned m = 0; m < s->mNumMeshes; ++m) skinned = skinned || s->mMeshes[m]->mNumBones > 0;
+
+  // Time line, seconds -> ticks.
+  const double tps = anim->mTicksPerSecond > 0 ? anim->mTicksPerSecond : 25.0;
+  const double duration = anim->mDuration / tps;
+  if (opt.start_seconds > duration) fail(path, "start_seconds beyond the clip length " + std::to_string(duration) + " s");
+  double end = duration;
+  if (opt.max_seconds >= 0) end = std::min(end, opt.start_seconds + opt.max_seconds);
+  const int n_motion = rest_only ? 1 : static_cast<int>(std::floor((end - opt.start_seconds) * opt.fps + 1e-9)) + 1;
+
+  const size_t nn = rig.node.size();
+  auto motion_local = [&](double seconds) {
+    std::vector<Trs> L(rig.rest);
+    for (size_t i = 0; i < nn; ++i)
+      if (rig.channel[i]) L[i] = sample(rig.channel[i], seconds * tps, rig.rest[i]);
+    return L;
+  };
+  const std::vector<Trs> first = motion_local(opt.start_seconds);
+  std::vector<Trs> rest_local(rig.rest);
+  for (size_t i = 0; i < nn; ++i)
+    if (rig.channel[i]) rest_local[i].t = first[i].t;
+  const std::vector<Mat4> G_rest = rig.globals(rest_local);
+
+  // Body surface and skin.
+  Skin sk;
+  detail::SkinnedBody sb;
+  if (skinned) {
+    sk = skin_from_meshes(s, rig, path);
+    weld(sk, sk.apply(G_rest));
+  } else {
+    // Skeleton: all nodes below (and including) the first animated node's top ancestor
+    // that carries a channel; here simply every node, positions at the rest pose.
+    int root = -1;
+    for (size_t i = 0; i < nn && root < 0; ++i)
+      if (rig.channel[i]) root = static_cast<int>(i);
+    if (root < 0) fail(path, "no animated node (no skeleton)");
+    while (rig.parent[root] >= 0 && rig.channel[rig.parent[root]]) root = rig.parent[root];
+    std::vector<detail::SkelNode> nodes;
+    std::vector<int> to_rig;
+    std::map<int, int> from_rig;
+    for (size_t i = root; i < nn; ++i) {
+      const int p = rig.parent[i];
+      if (static_cast<int>(i) != root && !from_rig.count(p)) continue;
+      from_rig[static_cast<int>(i)] = static_cast<int>(nodes.size());
+      to_rig.push_back(static_cast<int>(i));
+      detail::SkelNode sn;
+      sn.name = rig.node[i]->mName.C_Str();
+      sn.parent = static_cast<int>(i) == root ? -1 : from_rig[p];
+      sn.pos = G_rest[i].topRightCorner<3, 1>();
+      nodes.push_back(sn);
+    }
+    if (nodes.size() < 3) fail(path, "skeleton has fewer than 3 joints");
+    double ymin = 1e300, ymax = -1e300;
+    for (auto& sn : nodes) ymin = std::min(ymin, sn.pos.y()), ymax = std::max(ymax, sn.pos.y());
+    if (!(ymax - ymin > 0)) fail(path, "skeleton has zero height at the rest pose");
+    const double mpu = opt.height / ((ymax - ymin) * 1.04);
+    sb = detail::build_skeleton_body(nodes, mpu, opt.body_edge);
+    // Skin matrices: node k -> G(t) * G_rest^-1, bind space = rest world.
+    sk.P = sb.V;
+    sk.F = sb.F;
+    sk.start = sb.skin_start;
+    for (size_t k = 0; k < nodes.size(); ++k) {
+      sk.mat_node.push_back(to_rig[k]);
+      sk.mat_bind.push_back(G_rest[to_rig[k]].inverse());
+    }
+    sk.mat = sb.skin_node;
+    sk.weight = sb.skin_weight;
+  }
+
+  // Similarity to metres, rest pose standing on y = 0, centred in x and z.
+  const Points3 rest_raw = sk.apply(G_rest);
+  if (!rest_raw.allFinite()) fail(path, "rest pose has non-finite vertices");
+  const Vec3 lo = rest_raw.colwise().minCoeff(), hi = rest_raw.colwise().maxCoeff();
+  if (!(hi.y() - lo.y() > 0)) fail(path, "body has zero height at the rest pose");
+  // Skeleton bodies: standing height counts the legs as vertical (rest poses may spread them).
+  const double scale = opt.height / (hi.y() - lo.y() + (skinned ? 0.0 : sb.leg_extra));
+  const Vec3 shift(0.5 * (lo.x() + hi.x()), lo.y(), 0.5 * (lo.z() + hi.z()));
+  auto to_out = [&](const Points3& X) {
+    Points3 Y = (X.rowwise() - shift.transpose()) * scale;
+    return Y;
+  };
+
+  BodySequence seq;
+  seq.F = sk.F;
+  // Mirroring bind transforms flip triangles: make closed meshes enclose positive volume.
+  {
+    double vol = 0;
+    for (Eigen::Index f = 0; f < seq.F.rows(); ++f)
+      vol += Vec3(rest_raw.row(seq.F(f, 0))).dot(Vec3(rest_raw.row(seq.F(f, 1))).cross(Vec3(rest_raw.row(seq.F(f, 2)))));
+    if (vol < 0) seq.F.col(1).swap(seq.F.col(2));
+  }
+  seq.fps = opt.fps;
+  seq.source = path;
+  seq.from_skeleton = !skinned;
+  seq.rest_V = to_out(rest_raw);
+  seq.rest_blend_frames = rest_only ? 0 : opt.rest_blend_frames;
+  if (!rest_only) {
+    const int B = opt.rest_blend_frames;
+    seq.frames.resize(B + n_motion);
+    // Frames are independent: parallel over frames (skinning one frame is too small to split).
+    int bad_frame = -1;
+#pragma omp parallel for schedule(dynamic, 4)
+    for (int f = 0; f < B + n_motion; ++f) {
+      std::vector<Trs> L;
+      if (f < B) {
+        const double a = smoothstep(static_cast<double>(f) / B);
+        L = rest_local;
+        for (size_t i = 0; i < nn; ++i) {
+          L[i].t = (1 - a) * rest_local[i].t + a * first[i].t;
+          L[i].r = rest_local[i].r.slerp(a, first[i].r);
+          L[i].s = (1 - a) * rest_local[i].s + a * first[i].s;
+        }
+      } else {
+        const int k = f - B;
+        L = k == 0 ? first : motion_local(opt.start_seconds + k / opt.fps);
+      }
+      seq.frames[f] = to_out(sk.apply(rig.globals(L)));
+      if (!seq.frames[f].allFinite()) {
+#pragma omp critical
+        bad_frame = f;
+      }
+    }
+    if (bad_frame >= 0) fail(path, "non-finite vertices at frame " + std::to_string(bad_frame));
+  }
+
+  // Landmarks.
+  BodyLandmarks& lm = seq.landmarks;
+  lm.height = opt.height;
+  const TriMesh rest{seq.rest_V, seq.F};
+  auto out_pt = [&](const Vec3& p) { return Vec3((p - shift) * scale); };
+  Vec3 hip_c, waist_c, chest_c;
+  if (!skinned) {
+    hip_c = out_pt(sb.hip_c), waist_c = out_pt(sb.waist_c), chest_c = out_pt(sb.chest_c);
+    lm.shoulder_y = out_pt(Vec3(0, sb.shoulder_y, 0)).y();
+  } else {
+    const double H = opt.height;
+    hip_c = Vec3(0, 0.52 * H, 0), waist_c = Vec3(0, 0.61 * H, 0), chest_c = Vec3(0, 0.72 * H, 0);
+    lm.shoulder_y = 0.82 * H;
+  }
+  try {
+    lm.hips = measure_section(rest, hip_c.y(), hip_c.x(), hip_c.z());
+    lm.waist = measure_section(rest, waist_c.y(), waist_c.x(), waist_c.z());
+    lm.chest = measure_section(rest, chest_c.y(), chest_c.x(), chest_c.z());
+  } catch (const std::exception&) {
+    // Not a human-like shape (e.g. a test rig): leave the sections empty.
+  }
+  // Crotch: lowest crossing of the vertical line through the hip centre.
+  lm.crotch_y = 0;
+  {
+    const double x = hip_c.x(), z = hip_c.z();
+    double best = 1e300;
+    for (Eigen::Index f = 0; f < seq.F.rows(); ++f) {
+      const Vec3 a = rest.V.row(seq.F(f, 0)), b = rest.V.row(seq.F(f, 1)), c = rest.V.row(seq.F(f, 2));
+      // 2-D barycentrics in the xz plane
+      const double d = (b.x() - a.x()) * (c.z() - a.z()) - (c.x() - a.x()) * (b.z() - a.z());
+      if (std::abs(d) < 1e-18) continue;
+      const double u = ((x - a.x()) * (c.z() - a.z()) - (c.x() - a.x()) * (z - a.z())) / d;
+      const double v = ((b.x() - a.x()) * (z - a.z()) - (x - a.x()) * (b.z() - a.z())) / d;
+      if (u < 0 || v < 0 || u + v > 1) continue;
+      best = std::min(best, a.y() + u * (b.y() - a.y()) + v * (c.y() - a.y()));
+    }
+    if (best < 1e300) lm.crotch_y = best;
+  }
+  return seq;
+}
+
+}  // namespace
+
+TriMesh BodySequence::frame_mesh(int t) const {
+  if (t < 0 || t >= num_frames())
+    throw std::runtime_error("BodySequence::frame_mesh: frame " + std::to_string(t) + " out of range [0, " +
+                             std::to_string(num_frames()) + ") for " + source);
+  return TriMesh{frames[t], F};
+}
+
+BodySequence load_body_sequence(const std::string& path, const BodyOptions& opt) { return load(path, opt, false); }
+
+BodySection measure_section(const TriMesh& mesh, double y, double ax, double az, double max_radius) {
+  std::vector<Vec2> pts;
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+    for (int e = 0; e < 3; ++e) {
+      const Vec3 a = mesh.V.row(mesh.F(f, e)), b = mesh.V.row(mesh.F(f, (e + 1) % 3));
+      if ((a.y() - y) * (b.y() - y) > 0 || a.y() == b.y()) continue;
+      const double s = (y - a.y()) / (b.y() - a.y());
+      const Vec3 p = a + s * (b - a);
+      if (std::hypot(p.x() - ax, p.z() - az) <= max_radius) pts.emplace_back(p.x(), p.z());
+    }
+  if (pts.size() < 3)
+    throw std::runtime_error("measure_section: plane y = " + std::to_string(y) + " misses the mesh near the axis");
+  // Convex hull (monotone chain) for the circumference.
+  std::sort(pts.begin(), pts.end(), [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  auto cross = [](const Vec2& o, const Vec2& a, const Vec2& b) { return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x(); };
+  std::vector<Vec2> hull(2 * pts.size());
+  size_t k = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
+    hull[k++] = pts[i];
+  }
+  for (size_t i = pts.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && cross(hull[k - 2], hull[k - 1], pts[i - 1]) <= 0) --k;
+    hull[k++] = pts[i - 1];
+  }
+  hull.resize(k - 1);
+  BodySection s;
+  s.y = y;
+  double x0 = 1e300, x1 = -1e300, z0 = 1e300, z1 = -1e300;
+  for (const Vec2& p : pts) x0 = std::min(x0, p.x()), x1 = std::max(x1, p.x()), z0 = std::min(z0, p.y()), z1 = std::max(z1, p.y());
+  s.cx = 0.5 * (x0 + x1), s.cz = 0.5 * (z0 + z1);
+  s.half_width = 0.5 * (x1 - x0), s.half_depth = 0.5 * (z1 - z0);
+  for (size_t i = 0; i < hull.size(); ++i) s.circumference += (hull[(i + 1) % hull.size()] - hull[i]).norm();
+  return s;
+}
+
+TriMesh load_body_rest(const std::string& path, const BodyOptions& opt, BodyLandmarks* landmarks) {
+  BodySequence s = load(path, opt, true);
+  if (landmarks) *landmarks = s.landmarks;
+  return s.rest_mesh();
+}
+
+}  // namespace gdsr

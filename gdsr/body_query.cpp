@@ -1,0 +1,346 @@
+#include "gdsr/body_query.hpp"
+
+#include <embree3/rtcore.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace gdsr {
+namespace {
+
+RTCDevice shared_device() {
+  static RTCDevice dev = [] {
+    RTCDevice d = rtcNewDevice(nullptr);
+    if (!d) throw std::runtime_error("BodyQuery: cannot create an Embree device");
+    return d;
+  }();
+  return dev;
+}
+
+// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection 5.1.5).
+// region: 0 face, 1..3 vertex a/b/c, 4 edge ab, 5 edge bc, 6 edge ca.
+inline Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, double& u,
+                                double& v, double& w, int& region) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) { u = 1, v = 0, w = 0, region = 1; return a; }
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) { u = 0, v = 1, w = 0, region = 2; return b; }
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const double t = d1 / (d1 - d3);
+    u = 1 - t, v = t, w = 0, region = 4;
+    return a + t * ab;
+  }
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) { u = 0, v = 0, w = 1, region = 3; return c; }
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const double t = d2 / (d2 - d6);
+    u = 1 - t, v = 0, w = t, region = 6;
+    return a + t * ac;
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    u = 0, v = 1 - t, w = t, region = 5;
+    return b + t * (c - b);
+  }
+  const double den = va + vb + vc;
+  if (!(std::abs(den) > 0)) {  // degenerate triangle: fall back to vertex a
+    u = 1, v = 0, w = 0, region = 1;
+    return a;
+  }
+  const double vv = vb / den, ww = vc / den;
+  u = 1 - vv - ww, v = vv, w = ww, region = 0;
+  return a + ab * vv + ac * ww;
+}
+
+}  // namespace
+
+struct BodyQuery::Impl {
+  TriMesh mesh;
+  Update mode = Update::Rebuild;
+  RTCScene scene = nullptr;
+  RTCGeometry geom = nullptr;
+  Points3 fn, vn;                      // face / vertex normals (unit)
+  Eigen::Matrix<double, Eigen::Dynamic, 9, Eigen::RowMajor> en;  // per face: 3 edge pseudonormals
+  Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> adj;  // face across edge e (F(e)->F(e+1)), -1 none
+
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+  }
+
+  void check_vertices(const Points3& V, const char* op) const {
+    if (!V.allFinite()) {
+      for (Eigen::Index i = 0; i < V.rows(); ++i)
+        if (!V.row(i).allFinite())
+          throw std::runtime_error(std::string("BodyQuery::") + op + ": vertex " + std::to_string(i) + " is not finite");
+    }
+  }
+
+  void upload() {
+    auto* vb = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+    const Eigen::Index n = mesh.V.rows();
+#pragma omp parallel for schedule(static) if (n > 4096)
+    for (Eigen::Index i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k) vb[3 * i + k] = static_cast<float>(mesh.V(i, k));
+    rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcCommitGeometry(geom);
+    rtcCommitScene(scene);
+    const RTCError err = rtcGetDeviceError(shared_device());
+    if (err != RTC_ERROR_NONE) throw std::runtime_error("BodyQuery: Embree error " + std::to_string(err) + " on commit");
+    normals();
+  }
+
+  void normals() {
+    const Eigen::Index nf = mesh.F.rows(), nv = mesh.V.rows();
+    fn.resize(nf, 3);
+    Points3 acc = Points3::Zero(nv, 3);
+#pragma omp parallel for schedule(static)
+    for (Eigen::Index f = 0; f < nf; ++f) {
+      const Vec3 a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+      const Vec3 n = (b - a).cross(c - a);
+      const double l = n.norm();
+      fn.row(f) = l > 0 ? Eigen::RowVector3d(n.transpose() / l) : Eigen::RowVector3d::Zero();
+    }
+    // Angle-weighted vertex normals (serial scatter; O(F)).
+    for (Eigen::Index f = 0; f < nf; ++f) {
+      const Vec3 n = fn.row(f);
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 p = mesh.V.row(mesh.F(f, k));
+        const Vec3 e1 = Vec3(mesh.V.row(mesh.F(f, (k + 1) % 3))) - p, e2 = Vec3(mesh.V.row(mesh.F(f, (k + 2) % 3))) - p;
+        const double l1 = e1.norm(), l2 = e2.norm();
+        if (!(l1 > 0 && l2 > 0)) continue;
+        const double ang = std::acos(std::clamp(e1.dot(e2) / (l1 * l2), -1.0, 1.0));
+        acc.row(mesh.F(f, k)) += ang * n.transpose();
+      }
+    }
+    vn.resize(nv, 3);
+#pragma omp parallel for schedule(static)
+    for (Eigen::Index i = 0; i < nv; ++i) {
+      const double l = acc.row(i).norm();
+      vn.row(i) = l > 0 ? Eigen::RowVector3d(acc.row(i) / l) : Eigen::RowVector3d::Zero();
+    }
+    en.resize(nf, 9);
+#pragma omp parallel for schedule(static)
+    for (Eigen::Index f = 0; f < nf; ++f)
+      for (int e = 0; e < 3; ++e) {
+        Vec3 n = fn.row(f);
+        if (adj(f, e) >= 0) n += Vec3(fn.row(adj(f, e)));
+        const double l = n.norm();
+        en.block<1, 3>(f, 3 * e) = l > 0 ? Eigen::RowVector3d(n.transpose() / l) : Eigen::RowVector3d::Zero();
+      }
+  }
+};
+
+BodyQuery::BodyQuery(const TriMesh& mesh, Update mode) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  if (mesh.V.rows() == 0 || mesh.F.rows() == 0)
+    throw std::runtime_error("BodyQuery: empty mesh (" + std::to_string(mesh.V.rows()) + " vertices, " +
+                             std::to_string(mesh.F.rows()) + " faces)");
+  if (mesh.F.minCoeff() < 0 || mesh.F.maxCoeff() >= mesh.V.rows())
+    throw std::runtime_error("BodyQuery: face index out of range [0, " + std::to_string(mesh.V.rows()) + ")");
+  m.check_vertices(mesh.V, "BodyQuery");
+  m.mesh = mesh;
+  m.mode = mode;
+  // Face adjacency across edges (for edge pseudonormals).
+  const Eigen::Index nf = mesh.F.rows();
+  m.adj.setConstant(nf, 3, -1);
+  std::unordered_map<long long, int> dir;
+  dir.reserve(3 * nf);
+  const long long nv = mesh.V.rows();
+  for (Eigen::Index f = 0; f < nf; ++f)
+    for (int e = 0; e < 3; ++e) dir[mesh.F(f, e) * nv + mesh.F(f, (e + 1) % 3)] = static_cast<int>(f);
+  for (Eigen::Index f = 0; f < nf; ++f)
+    for (int e = 0; e < 3; ++e) {
+      auto it = dir.find(mesh.F(f, (e + 1) % 3) * nv + mesh.F(f, e));
+      if (it != dir.end()) m.adj(f, e) = it->second;
+    }
+
+  RTCDevice dev = shared_device();
+  m.scene = rtcNewScene(dev);
+  rtcSetSceneFlags(m.scene, RTC_SCENE_FLAG_DYNAMIC | RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_LOW);
+  m.geom = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+  rtcSetGeometryBuildQuality(m.geom, mode == Update::Refit ? RTC_BUILD_QUALITY_REFIT : RTC_BUILD_QUALITY_LOW);
+  rtcSetNewGeometryBuffer(m.geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.V.rows());
+  auto* ib = static_cast<unsigned*>(
+      rtcSetNewGeometryBuffer(m.geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nf));
+  if (!ib) throw std::runtime_error("BodyQuery: Embree cannot allocate buffers");
+  for (Eigen::Index f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) ib[3 * f + k] = static_cast<unsigned>(mesh.F(f, k));
+  rtcAttachGeometry(m.scene, m.geom);
+  rtcReleaseGeometry(m.geom);  // the scene holds it
+  m.upload();
+}
+
+BodyQuery::~BodyQuery() = default;
+BodyQuery::BodyQuery(BodyQuery&&) noexcept = default;
+BodyQuery& BodyQuery::operator=(BodyQuery&&) noexcept = default;
+
+const TriMesh& BodyQuery::mesh() const { return impl_->mesh; }
+const Points3& BodyQuery::face_normals() const { return impl_->fn; }
+const Points3& BodyQuery::vertex_normals() const { return impl_->vn; }
+
+void BodyQuery::update(const Points3& V) {
+  Impl& m = *impl_;
+  if (V.rows() != m.mesh.V.rows())
+    throw std::runtime_error("BodyQuery::update: " + std::to_string(V.rows()) + " vertices, mesh has " +
+                             std::to_string(m.mesh.V.rows()));
+  m.check_vertices(V, "update");
+  m.mesh.V = V;
+  m.upload();
+}
+
+namespace {
+struct PQData {
+  const BodyQuery* owner;
+  const TriMesh* mesh;
+  Vec3 q;
+  double best_d2;
+  int face, region;
+  Vec3 cp;
+  double u, v, w;
+};
+
+bool pq_callback(RTCPointQueryFunctionArguments* args) {
+  auto* d = static_cast<PQData*>(args->userPtr);
+  const unsigned f = args->primID;
+  const TriMesh& M = *d->mesh;
+  const Vec3 a = M.V.row(M.F(f, 0)), b = M.V.row(M.F(f, 1)), c = M.V.row(M.F(f, 2));
+  double u, v, w;
+  int region;
+  const Vec3 p = closest_on_triangle(d->q, a, b, c, u, v, w, region);
+  const double d2 = (p - d->q).squaredNorm();
+  if (d2 < d->best_d2) {
+    d->best_d2 = d2, d->face = static_cast<int>(f), d->region = region, d->cp = p;
+    d->u = u, d->v = v, d->w = w;
+    // Conservative: Embree's bounds are float.
+    args->query->radius = static_cast<float>(std::sqrt(d2) * (1 + 1e-5) + 1e-6);
+    return true;
+  }
+  return false;
+}
+}  // namespace
+
+ClosestPoints BodyQuery::closest(const Points3& Q, bool smooth_normals, double max_distance) const {
+  const Impl& m = *impl_;
+  const Eigen::Index n = Q.rows();
+  if (!Q.allFinite())
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (!Q.row(i).allFinite())
+        throw std::runtime_error("BodyQuery::closest: query point " + std::to_string(i) + " is not finite");
+  if (!(max_distance > 0)) throw std::runtime_error("BodyQuery::closest: max_distance must be > 0");
+  ClosestPoints r;
+  r.point.resize(n, 3);
+  r.normal.resize(n, 3);
+  r.sdist.resize(n);
+  r.face.resize(n);
+  r.bary.resize(n, 3);
+  const double inf = std::numeric_limits<double>::infinity();
+  const float r0 = std::isinf(max_distance) ? inf : static_cast<float>(max_distance);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (Eigen::Index i = 0; i < n; ++i) {
+    PQData d{this, &m.mesh, Vec3(Q.row(i)), std::isinf(max_distance) ? inf : max_distance * max_distance, -1, 0,
+             Vec3::Zero(), 0, 0, 0};
+    RTCPointQuery pq;
+    pq.x = static_cast<float>(d.q.x()), pq.y = static_cast<float>(d.q.y()), pq.z = static_cast<float>(d.q.z());
+    pq.radius = r0;
+    pq.time = 0.f;
+    RTCPointQueryContext ctx;
+    rtcInitPointQueryContext(&ctx);
+    rtcPointQuery(m.scene, &pq, &ctx, pq_callback, &d);
+    if (d.face < 0) {
+      r.point.row(i) = Q.row(i);
+      r.normal.row(i).setZero();
+      r.sdist[i] = inf;
+      r.face[i] = -1;
+      r.bary.row(i).setZero();
+      continue;
+    }
+    const int f = d.face;
+    Vec3 pn;
+    switch (d.region) {
+      case 0: pn = m.fn.row(f); break;
+      case 1: case 2: case 3: pn = m.vn.row(m.mesh.F(f, d.region - 1)); break;
+      case 4: pn = m.en.block<1, 3>(f, 0); break;
+      case 5: pn = m.en.block<1, 3>(f, 3); break;
+      default: pn = m.en.block<1, 3>(f, 6); break;
+    }
+    const Vec3 diff = d.q - d.cp;
+    const double dist = std::sqrt(d.best_d2);
+    r.point.row(i) = d.cp.transpose();
+    r.sdist[i] = diff.dot(pn) < 0 ? -dist : dist;
+    r.face[i] = f;
+    r.bary.row(i) << d.u, d.v, d.w;
+    if (smooth_normals) {
+      Vec3 ns = d.u * Vec3(m.vn.row(m.mesh.F(f, 0))) + d.v * Vec3(m.vn.row(m.mesh.F(f, 1))) +
+                d.w * Vec3(m.vn.row(m.mesh.F(f, 2)));
+      const double l = ns.norm();
+      r.normal.row(i) = (l > 0 ? Vec3(ns / l) : pn).transpose();
+    } else {
+      r.normal.row(i) = pn.transpose();
+    }
+  }
+  return r;
+}
+
+RayHits BodyQuery::intersect(const Points3& O, const Points3& D, double tmin, double tmax) const {
+  const Impl& m = *impl_;
+  const Eigen::Index n = O.rows();
+  if (D.rows() != n)
+    throw std::runtime_error("BodyQuery::intersect: " + std::to_string(n) + " origins but " + std::to_string(D.rows()) +
+                             " directions");
+  if (!O.allFinite() || !D.allFinite()) throw std::runtime_error("BodyQuery::intersect: non-finite origin or direction");
+  if (!(tmin >= 0) || !(tmax >= tmin)) throw std::runtime_error("BodyQuery::intersect: need 0 <= tmin <= tmax");
+  RayHits r;
+  r.t.resize(n);
+  r.face.resize(n);
+  r.uv.resize(n, 2);
+  bool zero_dir = false;
+  const float ftmax = std::isinf(tmax) ? std::numeric_limits<float>::infinity() : static_cast<float>(tmax);
+#pragma omp parallel for schedule(dynamic, 256)
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (D.row(i).squaredNorm() == 0) {
+      zero_dir = true;
+      continue;
+    }
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    rh.ray.org_x = static_cast<float>(O(i, 0)), rh.ray.org_y = static_cast<float>(O(i, 1)),
+    rh.ray.org_z = static_cast<float>(O(i, 2));
+    rh.ray.dir_x = static_cast<float>(D(i, 0)), rh.ray.dir_y = static_cast<float>(D(i, 1)),
+    rh.ray.dir_z = static_cast<float>(D(i, 2));
+    rh.ray.tnear = static_cast<float>(tmin);
+    rh.ray.tfar = ftmax;
+    rh.ray.time = 0.f;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(m.scene, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+      r.t[i] = std::numeric_limits<double>::infinity();
+      r.face[i] = -1;
+      r.uv.row(i).setZero();
+    } else {
+      r.t[i] = rh.ray.tfar;
+      r.face[i] = static_cast<int>(rh.hit.primID);
+      r.uv.row(i) << rh.hit.u, rh.hit.v;
+    }
+  }
+  if (zero_dir) throw std::runtime_error("BodyQuery::intersect: zero ray direction");
+  return r;
+}
+
+}  // namespace gdsr

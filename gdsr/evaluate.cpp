@@ -1,0 +1,109 @@
+#include "gdsr/evaluate.hpp"
+
+#include "autograd/tensor.hpp"
+#include "gdsr/correspondence.hpp"
+#include "gdsr/geometry_ad.hpp"
+#include "gdsr/mesh_ops.hpp"
+
+#include <opencv2/quality/qualityssim.hpp>
+
+#include <stdexcept>
+
+namespace gdsr {
+
+cv::Mat uv_normal_map(const UVRaster& raster, const Faces& F, const Points3& V) {
+  const Points3 N = vertex_normals(V, F);
+  cv::Mat img(raster.height, raster.width, CV_32FC3, cv::Scalar(0, 0, 0));
+#pragma omp parallel for
+  for (int j = 0; j < raster.height; ++j) {
+    auto* row = img.ptr<cv::Vec3f>(j);
+    for (int i = 0; i < raster.width; ++i) {
+      const size_t p = static_cast<size_t>(j) * raster.width + i;
+      const int f = raster.tri[p];
+      if (f < 0) continue;
+      Vec3 n = Vec3::Zero();
+      for (int k = 0; k < 3; ++k) n += static_cast<double>(raster.bary[3 * p + k]) * N.row(F(f, k)).transpose();
+      for (int c = 0; c < 3; ++c) row[i][c] = static_cast<float>(0.5 * n[c] + 0.5);
+    }
+  }
+  return img;
+}
+
+double ssim(const cv::Mat& a, const cv::Mat& b) {
+  if (a.size() != b.size() || a.type() != b.type()) throw std::runtime_error("ssim: images differ in size or type");
+  const cv::Scalar s = cv::quality::QualitySSIM::compute(a, b, cv::noArray());
+  return (s[0] + s[1] + s[2]) / 3.0;
+}
+
+StretchEnergies stretch_energies(const GarmentMesh& g, const Points3& V) {
+  ag::NoGradGuard ng;
+  const MeshTopology topo = make_topology(g);
+  const UVGradient<double> w = uv_gradient(points_tensor<double>(V), topo);
+  StretchEnergies e;
+  const int64_t S = w.Fu.rows();
+  if (S == 0) return e;
+  for (int64_t f = 0; f < S; ++f) {
+    const Vec3 u(w.Fu.at(f, 0), w.Fu.at(f, 1), w.Fu.at(f, 2));
+    const Vec3 v(w.Fv.at(f, 0), w.Fv.at(f, 1), w.Fv.at(f, 2));
+    e.Eu += (u.norm() - 1) * (u.norm() - 1);
+    e.Ev += (v.norm() - 1) * (v.norm() - 1);
+    e.Euv += u.dot(v) * u.dot(v);
+  }
+  e.Eu /= S;
+  e.Ev /= S;
+  e.Euv /= S;
+  return e;
+}
+
+Evaluation evaluate(const Dataset& d, const std::vector<Points3>& G, int first_frame, int ssim_every,
+                    const std::function<void(int, int)>& progress) {
+  const int T = static_cast<int>(d.hr_frames.size());
+  if (first_frame < 0 || first_frame + static_cast<int>(G.size()) > T)
+    throw std::runtime_error("evaluate: predicted frames " + std::to_string(first_frame) + ".." +
+                             std::to_string(first_frame + static_cast<int>(G.size()) - 1) +
+                             " are outside the dataset's " + std::to_string(T) + " frames");
+  if (ssim_every < 1) ssim_every = 1;
+  Evaluation ev;
+  int n_ssim = 0;
+  const int count = static_cast<int>(G.size());
+  for (int k = 0; k < count; ++k) {
+    const int t = first_frame + k;
+    const Points3& truth = d.hr_frames[t];
+    if (G[k].rows() != truth.rows())
+      throw std::runtime_error("evaluate: frame " + std::to_string(t) + " has " + std::to_string(G[k].rows()) +
+                               " HR vertices, the dataset " + std::to_string(truth.rows()));
+    const Points3 up = upsample(d.corr, d.lr_frames[t]);
+    FrameEvaluation f;
+    f.frame = t;
+    f.error = (G[k] - truth).rowwise().norm().mean();
+    f.error_lr = (up - truth).rowwise().norm().mean();
+    if (k % ssim_every == 0) {
+      const cv::Mat ref = uv_normal_map(d.raster, d.hr.F, truth);
+      f.ssim = ssim(uv_normal_map(d.raster, d.hr.F, G[k]), ref);
+      f.ssim_lr = ssim(uv_normal_map(d.raster, d.hr.F, up), ref);
+      ev.mean.ssim += f.ssim;
+      ev.mean.ssim_lr += f.ssim_lr;
+      ++n_ssim;
+    }
+    f.energies = stretch_energies(d.hr, G[k]);
+    const StretchEnergies te = stretch_energies(d.hr, truth);
+    ev.truth.Eu += te.Eu / count;
+    ev.truth.Ev += te.Ev / count;
+    ev.truth.Euv += te.Euv / count;
+    ev.mean.error += f.error / count;
+    ev.mean.error_lr += f.error_lr / count;
+    ev.mean.energies.Eu += f.energies.Eu / count;
+    ev.mean.energies.Ev += f.energies.Ev / count;
+    ev.mean.energies.Euv += f.energies.Euv / count;
+    ev.frames.push_back(f);
+    if (progress) progress(k + 1, count);
+  }
+  if (n_ssim > 0) {
+    ev.mean.ssim /= n_ssim;
+    ev.mean.ssim_lr /= n_ssim;
+  }
+  ev.mean.frame = -1;
+  return ev;
+}
+
+}  // namespace gdsr

@@ -1,0 +1,119 @@
+#include "sim/sim_metrics.hpp"
+
+#include "sim/cloth_collision.hpp"
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+namespace sim {
+
+using gdsr::Points3;
+using gdsr::Vec2;
+using gdsr::Vec3;
+
+StrainEnergies strain_energies(const gdsr::GarmentMesh& g, const Points3& X) {
+  if (X.rows() != g.V.rows()) throw std::runtime_error("sim/sim_metrics: positions do not match the garment");
+  StrainEnergies s;
+  int n = 0;
+  for (int f = 0; f < g.F.rows(); ++f) {
+    const Vec2 u0 = g.UV.row(g.FUV(f, 0)), u1 = g.UV.row(g.FUV(f, 1)), u2 = g.UV.row(g.FUV(f, 2));
+    Eigen::Matrix2d Dm;
+    Dm.col(0) = u1 - u0;
+    Dm.col(1) = u2 - u0;
+    if (std::abs(Dm.determinant()) < 1e-14) continue;
+    Eigen::Matrix<double, 3, 2> Ds;
+    Ds.col(0) = X.row(g.F(f, 1)) - X.row(g.F(f, 0));
+    Ds.col(1) = X.row(g.F(f, 2)) - X.row(g.F(f, 0));
+    const Eigen::Matrix<double, 3, 2> w = Ds * Dm.inverse();
+    const double lu = w.col(0).norm(), lv = w.col(1).norm();
+    s.E_u += (lu - 1) * (lu - 1);
+    s.E_v += (lv - 1) * (lv - 1);
+    const double d = w.col(0).dot(w.col(1));
+    s.E_uv += d * d;
+    ++n;
+  }
+  if (n > 0) {
+    s.E_u /= n;
+    s.E_v /= n;
+    s.E_uv /= n;
+  }
+  return s;
+}
+
+Penetration body_penetration(const Points3& X, const gdsr::Faces& body_F, const Points3& body_V, double radius) {
+  Penetration p;
+  if (body_F.rows() == 0 || X.rows() == 0) return p;
+  SurfaceGrid grid;
+  grid.build(body_F, body_V, body_V, std::max(radius, 0.02));
+  double sum = 0;
+  for (int v = 0; v < X.rows(); ++v) {
+    const SurfaceHit h = grid.closest(X.row(v).transpose(), body_V, radius);
+    if (h.face >= 0 && h.signed_distance < 0) {
+      p.max_depth = std::max(p.max_depth, -h.signed_distance);
+      sum += -h.signed_distance;
+      ++p.count;
+    }
+  }
+  p.mean_depth = sum / X.rows();
+  return p;
+}
+
+double kinetic_energy(const gdsr::GarmentMesh& g, const Points3& X0, const Points3& X1, double dt, double density) {
+  std::vector<double> m(g.V.rows(), 0.0);
+  for (int f = 0; f < g.F.rows(); ++f) {
+    const Vec2 a = g.UV.row(g.FUV(f, 0)), b = g.UV.row(g.FUV(f, 1)), c = g.UV.row(g.FUV(f, 2));
+    const double area = 0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+    for (int k = 0; k < 3; ++k) m[g.F(f, k)] += density * area / 3;
+  }
+  double e = 0;
+  for (int v = 0; v < X0.rows(); ++v) e += 0.5 * m[v] * ((X1.row(v) - X0.row(v)) / dt).squaredNorm();
+  return e;
+}
+
+WrinkleMeasure wrinkle_measure(const Points3& X, const gdsr::Faces& F) {
+  WrinkleMeasure w;
+  std::map<std::pair<int, int>, std::vector<int>> ef;
+  std::vector<Vec3> n(F.rows());
+  double area = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    const Vec3 a = X.row(F(f, 0)), b = X.row(F(f, 1)), c = X.row(F(f, 2));
+    const Vec3 cr = (b - a).cross(c - a);
+    area += 0.5 * cr.norm();
+    n[f] = cr.norm() > 0 ? Vec3(cr.normalized()) : Vec3::Zero();
+    for (int k = 0; k < 3; ++k) {
+      const int i = F(f, k), j = F(f, (k + 1) % 3);
+      ef[{std::min(i, j), std::max(i, j)}].push_back(f);
+    }
+  }
+  double sum_theta = 0, sum_tl = 0;
+  int count = 0;
+  for (const auto& [e, fs] : ef) {
+    if (fs.size() != 2) continue;
+    const double theta = std::atan2(n[fs[0]].cross(n[fs[1]]).norm(), n[fs[0]].dot(n[fs[1]]));
+    sum_theta += theta;
+    sum_tl += theta * (X.row(e.first) - X.row(e.second)).norm();
+    ++count;
+  }
+  if (count > 0) w.mean_dihedral = sum_theta / count;
+  if (area > 0) w.mean_curvature = sum_tl / (2 * area);
+  return w;
+}
+
+std::vector<FrameMetrics> sequence_metrics(const gdsr::GarmentMesh& g, const std::vector<Points3>& frames,
+                                           const gdsr::Faces& body_F, const std::vector<Points3>& body_frames,
+                                           double fps, double density) {
+  std::vector<FrameMetrics> out(frames.size());
+  for (size_t t = 0; t < frames.size(); ++t) {
+    out[t].strain = strain_energies(g, frames[t]);
+    if (t < body_frames.size()) out[t].penetration = body_penetration(frames[t], body_F, body_frames[t]);
+    if (t > 0) out[t].kinetic_energy = kinetic_energy(g, frames[t - 1], frames[t], 1.0 / fps, density);
+    out[t].wrinkles = wrinkle_measure(frames[t], g.F);
+  }
+  return out;
+}
+
+}  // namespace sim

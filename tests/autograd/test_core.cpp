@@ -1,0 +1,99 @@
+// Graph mechanics: backward rules, accumulation, no-grad scope, detach, freeing.
+#include "ag_test_util.hpp"
+
+using namespace agt;
+
+TEST_CASE("core: backward from a non-scalar throws") {
+  Tensord x = randn({3, 2}, 1).set_requires_grad(true);
+  const Tensord y = x * x;
+  CHECK_THROWS_WITH_AS(y.backward(), doctest::Contains("one-element"), ag::Error);
+  CHECK_THROWS_AS(randn({1, 1}, 2).backward(), ag::Error);  // no grad required
+}
+
+TEST_CASE("core: gradients accumulate over two backward calls") {
+  Tensord x = randn({3, 2}, 3).set_requires_grad(true);
+  sum(x * x).backward();
+  const std::vector<double> g1 = x.grad();
+  sum(x * x).backward();
+  for (size_t i = 0; i < g1.size(); ++i) {
+    CHECK(g1[i] == doctest::Approx(2 * x.values()[i]));
+    CHECK(x.grad()[i] == doctest::Approx(2 * g1[i]));
+  }
+  x.zero_grad();
+  CHECK_FALSE(x.has_grad());
+  // retained graph run twice accumulates into leaves, not into intermediates
+  const Tensord y = ag::tanh(x);
+  const Tensord l = sum(y * y);
+  l.backward(true);
+  const std::vector<double> g2 = x.grad();
+  l.backward();
+  for (size_t i = 0; i < g2.size(); ++i) CHECK(x.grad()[i] == doctest::Approx(2 * g2[i]));
+}
+
+TEST_CASE("core: NoGradGuard records nothing, nests, restores") {
+  Tensord x = randn({3, 2}, 4).set_requires_grad(true);
+  {
+    ag::NoGradGuard ng;
+    CHECK_FALSE(ag::grad_enabled());
+    {
+      ag::NoGradGuard inner;
+      CHECK_FALSE(ag::grad_enabled());
+    }
+    CHECK_FALSE(ag::grad_enabled());
+    const Tensord y = ag::normalize_rows(ag::linear(x, randn({4, 2}, 5), Tensord()));
+    CHECK_FALSE(y.requires_grad());
+    CHECK(y.node().parents.empty());
+    CHECK_FALSE(static_cast<bool>(y.node().backward_fn));
+    CHECK_THROWS_AS(sum(y).backward(), ag::Error);
+  }
+  CHECK(ag::grad_enabled());
+  CHECK(sum(x).requires_grad());
+}
+
+TEST_CASE("core: detach cuts the graph") {
+  Tensord x = randn({3, 2}, 6).set_requires_grad(true);
+  const Tensord y = x * x;
+  const Tensord d = y.detach();
+  CHECK_FALSE(d.requires_grad());
+  CHECK(d.values() == y.values());
+  sum(d * x).backward();  // d is a constant: grad = d
+  for (size_t i = 0; i < d.values().size(); ++i) CHECK(x.grad()[i] == doctest::Approx(d.values()[i]));
+}
+
+TEST_CASE("core: intermediates are freed after backward") {
+  Tensord x = randn({4, 3}, 7).set_requires_grad(true);
+  std::weak_ptr<ag::Node<double>> mid;
+  Tensord loss;
+  {
+    const Tensord h = ag::channel_norm(ag::relu(x * 2.0));
+    mid = h.node_ptr();
+    loss = ag::mean(ag::square(h));
+  }
+  CHECK_FALSE(mid.expired());  // kept alive by the graph
+  loss.backward();
+  CHECK(mid.expired());  // released: the loss node dropped its parents
+  CHECK(x.has_grad());
+  CHECK(loss.node().parents.empty());
+}
+
+TEST_CASE("core: a small real model is the same in float32 and float64 within 1e-5") {
+  const Tensord x = randn({32, 6}, 8), w1 = randn({8, 6}, 9, 0.4), w2 = randn({3, 8}, 10, 0.4),
+                b = randn({1, 8}, 11, 0.1), t = randn({32, 3}, 12);
+  auto model = [](const auto& x, const auto& w1, const auto& b, const auto& w2, const auto& t) {
+    using T = typename std::decay_t<decltype(x)>::Scalar;
+    auto h = ag::leaky_relu(ag::channel_norm(ag::linear(x, w1, b)), T(0.02));
+    auto y = ag::linear(ag::layer_norm(h), w2, std::decay_t<decltype(x)>());
+    auto g = ag::scatter_mean_rows(ag::index_select_rows(y, {0, 5, 7, 31, 2}), {0, 1, 0, 1, 1}, 2);
+    return ag::mse_loss(y, t) + ag::mean(ag::norm_rows(g));
+  };
+  Tensorf xf = to_float(x), w1f = to_float(w1).set_requires_grad(true);
+  Tensord w1d = w1.detach().set_requires_grad(true);
+  const Tensord ld = model(x, w1d, b, w2, t);
+  const Tensorf lf = model(xf, w1f, to_float(b), to_float(w2), to_float(t));
+  CHECK(std::abs(double(lf.item()) - ld.item()) < 1e-5);
+  ld.backward();
+  lf.backward();
+  double err = 0;
+  for (size_t i = 0; i < w1d.grad().size(); ++i) err = std::max(err, std::abs(double(w1f.grad()[i]) - w1d.grad()[i]));
+  CHECK(err < 1e-5);
+}

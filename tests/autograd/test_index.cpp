@@ -1,0 +1,87 @@
+// Gradient checks of gather / scatter / interpolate.
+#include "ag_test_util.hpp"
+
+using namespace agt;
+
+namespace {
+constexpr double kTol = 1e-6;  // linear (bilinear for interpolate) ops
+}
+
+TEST_CASE("index: index_select_rows with repeated indices") {
+  const Tensord x = randn({5, 3}, 1);
+  const ag::Index idx{4, 0, 0, 2, 4, 4, 1};
+  check_grad("index_select_rows", kTol, [idx](auto& in) { return ag::index_select_rows(in[0], idx); }, {x});
+  const Tensord y = ag::index_select_rows(x, idx);
+  CHECK(y.shape() == ag::Shape{7, 3});
+  CHECK(y.at(5, 2) == x.at(4, 2));
+  // gradient of sum(gather) counts the uses of each row
+  Tensord xl = x.detach().set_requires_grad(true);
+  sum(ag::index_select_rows(xl, idx)).backward();
+  CHECK(xl.grad()[4 * 3] == 3.0);
+  CHECK(xl.grad()[3 * 3] == 0.0);
+}
+
+TEST_CASE("index: scatter_add_rows and scatter_mean_rows") {
+  const Tensord x = randn({8, 3}, 2);
+  const ag::Index idx{0, 2, 2, 5, 0, 2, 1, 5};  // rows 3, 4 get nothing
+  check_grad("scatter_add_rows", kTol, [idx](auto& in) { return ag::scatter_add_rows(in[0], idx, 6); }, {x});
+  check_grad("scatter_mean_rows", kTol, [idx](auto& in) { return ag::scatter_mean_rows(in[0], idx, 6); }, {x});
+  const Tensord s = ag::scatter_add_rows(x, idx, 6), m = ag::scatter_mean_rows(x, idx, 6);
+  CHECK(s.shape() == ag::Shape{6, 3});
+  CHECK(s.at(2, 1) == doctest::Approx(x.at(1, 1) + x.at(2, 1) + x.at(5, 1)));
+  CHECK(m.at(2, 1) == doctest::Approx((x.at(1, 1) + x.at(2, 1) + x.at(5, 1)) / 3));
+  CHECK(s.at(3, 0) == 0.0);
+  CHECK(m.at(4, 2) == 0.0);
+}
+
+TEST_CASE("index: interpolate_rows w.r.t. x and weight") {
+  const Tensord x = randn({6, 4}, 3);
+  const Tensord w = randu({5, 3}, 4, 0.0, 1.0);
+  const ag::Index idx = rand_index(5 * 3, 6, 5);
+  check_grad("interpolate_rows", kTol,
+             [idx](auto& in) { return ag::interpolate_rows(in[0], idx, in[1]); }, {x, w});
+  const Tensord y = ag::interpolate_rows(x, idx, w);
+  double e = 0;
+  for (int k = 0; k < 3; ++k) e += w.at(2, k) * x.at(idx[2 * 3 + k], 1);
+  CHECK(y.at(2, 1) == doctest::Approx(e));
+}
+
+TEST_CASE("index: complex gather, scatter and interpolate") {
+  const Tensord re = randn({5, 2}, 6), im = randn({5, 2}, 7), wr = randn({4, 2}, 8), wi = randn({4, 2}, 9);
+  const ag::Index g{1, 1, 4, 0}, s{0, 2, 2, 1, 0}, ip = rand_index(8, 5, 10);
+  check_grad("complex gather+scatter", kTol,
+             [g, s](auto& in) {
+               const auto z = cplx(in[0], in[1]);
+               return split(ag::index_select_rows(ag::scatter_add_rows(z, s, 3), {2, 0}) +
+                            ag::scatter_mean_rows(ag::index_select_rows(z, g), {0, 1, 0, 1}, 2));
+             },
+             {re, im});
+  check_grad("complex interpolate", kTol,
+             [ip](auto& in) { return split(ag::interpolate_rows(cplx(in[0], in[1]), ip, cplx(in[2], in[3]))); },
+             {re, im, wr, wi});
+}
+
+TEST_CASE("index: out-of-range indices are refused") {
+  const Tensord x = randn({3, 2}, 11);
+  CHECK_THROWS_WITH_AS(ag::index_select_rows(x, {0, 3}), doctest::Contains("index_select_rows"), ag::Error);
+  CHECK_THROWS_AS(ag::scatter_add_rows(x, {0, 1, 5}, 4), ag::Error);
+  CHECK_THROWS_AS(ag::scatter_add_rows(x, {0, 1}, 4), ag::Error);  // wrong count
+  CHECK_THROWS_AS(ag::interpolate_rows(x, {0, 1, 2}, randn({2, 2}, 12)), ag::Error);
+}
+
+TEST_CASE("index: large parallel gather/scatter agree with a serial reference") {
+  const int64_t R = 3000, N = 20000, C = 8;
+  const Tensord x = randn({N, C}, 13);
+  const ag::Index idx = rand_index(N, R, 14);
+  const Tensord s = ag::scatter_add_rows(x, idx, R);
+  Eigen::MatrixXd ref = Eigen::MatrixXd::Zero(R, C);
+  for (int64_t i = 0; i < N; ++i) ref.row(idx[i]) += x.mat().row(i);
+  CHECK((s.mat() - ref).cwiseAbs().maxCoeff() < 1e-12);
+  Tensord xl = x.detach().set_requires_grad(true);
+  const Tensord w = randn({R, C}, 15);
+  sum(ag::scatter_add_rows(xl, idx, R) * w).backward();
+  double err = 0;
+  for (int64_t i = 0; i < N; ++i)
+    for (int64_t j = 0; j < C; ++j) err = std::max(err, std::abs(xl.grad()[i * C + j] - w.at(idx[i], j)));
+  CHECK(err == 0.0);
+}

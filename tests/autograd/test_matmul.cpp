@@ -1,0 +1,72 @@
+// Gradient checks of matmul, linear and transpose (real and complex).
+#include "ag_test_util.hpp"
+
+using namespace agt;
+using ag::Tensorcd;
+
+namespace {
+constexpr double kTol = 1e-6;  // smooth (bilinear) ops
+}
+
+TEST_CASE("matmul: gradient and value") {
+  const Tensord a = randn({5, 3}, 1), b = randn({3, 4}, 2);
+  check_grad("matmul", kTol, [](auto& in) { return ag::matmul(in[0], in[1]); }, {a, b});
+  const Tensord c = ag::matmul(a, b);
+  const Eigen::MatrixXd e = a.mat() * b.mat();
+  CHECK((c.mat() - e).cwiseAbs().maxCoeff() < 1e-14);
+}
+
+TEST_CASE("matmul: shape mismatch names the op and both shapes") {
+  const Tensord a = randn({5, 3}, 1), b = randn({4, 4}, 2);
+  CHECK_THROWS_WITH_AS(ag::matmul(a, b), doctest::Contains("matmul"), ag::Error);
+  CHECK_THROWS_WITH_AS(ag::matmul(a, b), doctest::Contains("[5 x 3]"), ag::Error);
+  CHECK_THROWS_WITH_AS(ag::matmul(a, b), doctest::Contains("[4 x 4]"), ag::Error);
+  CHECK_THROWS_WITH_AS(ag::linear(a, b, Tensord()), doctest::Contains("linear"), ag::Error);
+}
+
+TEST_CASE("linear: with and without bias, scaled inputs") {
+  const Tensord x = randn({6, 4}, 3), w = randn({3, 4}, 4), b = randn({1, 3}, 5);
+  check_grad("linear+bias", kTol, [](auto& in) { return ag::linear(in[0], in[1], in[2]); }, {x, w, b});
+  check_grad("linear", kTol, [](auto& in) { return ag::linear(in[0], in[1], Tensord()); }, {x, w});
+  for (double s : {1e-3, 1e3}) {
+    INFO("scale " << s);
+    check_grad("linear scaled", kTol, [](auto& in) { return ag::linear(in[0], in[1], in[2]); },
+               {randn({6, 4}, 6, s), randn({3, 4}, 7, s), randn({1, 3}, 8, s)});
+  }
+  const Tensord y = ag::linear(x, w, b);
+  const Eigen::MatrixXd e = (x.mat() * w.mat().transpose()).rowwise() + b.mat().row(0);
+  CHECK((y.mat() - e).cwiseAbs().maxCoeff() < 1e-14);
+}
+
+TEST_CASE("transpose: gradient and value") {
+  const Tensord a = randn({5, 3}, 9);
+  check_grad("transpose", kTol, [](auto& in) { return ag::transpose(in[0]); }, {a});
+  const Tensord t = ag::transpose(a);
+  CHECK(t.shape() == ag::Shape{3, 5});
+  CHECK(t.at(2, 4) == a.at(4, 2));
+}
+
+TEST_CASE("matmul, linear, transpose: complex") {
+  const Tensord ar = randn({4, 3}, 11), ai = randn({4, 3}, 12), br = randn({3, 5}, 13),
+                bi = randn({3, 5}, 14), cr = randn({1, 5}, 15), ci = randn({1, 5}, 16);
+  check_grad("complex matmul", kTol,
+             [](auto& in) { return split(ag::matmul(cplx(in[0], in[1]), cplx(in[2], in[3]))); },
+             {ar, ai, br, bi});
+  // linear: x [4 x 3], weight [5 x 3] = transpose of b
+  check_grad("complex linear", kTol,
+             [](auto& in) {
+               return split(ag::linear(cplx(in[0], in[1]), ag::transpose(cplx(in[2], in[3])),
+                                       cplx(in[4], in[5])));
+             },
+             {ar, ai, br, bi, cr, ci});
+  check_grad("complex transpose", kTol,
+             [](auto& in) { return split(ag::transpose(cplx(in[0], in[1]))); }, {ar, ai});
+}
+
+TEST_CASE("matmul, linear: float32 matches float64 within 1e-5") {
+  const Tensord x = randn({7, 6}, 21, 0.3), w = randn({5, 6}, 22, 0.3), b = randn({1, 5}, 23);
+  const auto d = ag::linear(x, w, b);
+  const auto s = ag::linear(to_float(x), to_float(w), to_float(b));
+  CHECK(max_abs_diff(s, d) < 1e-5);
+  CHECK(max_abs_diff(ag::matmul(to_float(x), ag::transpose(to_float(w))), ag::matmul(x, ag::transpose(w))) < 1e-5);
+}
