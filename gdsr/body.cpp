@@ -281,7 +281,25 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
 
   // Time line, seconds -> ticks.
   const double tps = anim->mTicksPerSecond > 0 ? anim->mTicksPerSecond : 25.0;
-  const double duration = anim->mDuration / tps;
+  // Calibration key: largest per-channel rotation between keys 0-1 vs keys 1-2.
+  double t0 = 0;  // clip start, seconds
+  if (opt.skip_calibration_key) {
+    double j01 = 0, j12 = 0;
+    double t1 = -1;
+    for (size_t i = 0; i < rig.node.size(); ++i) {
+      const aiNodeAnim* ch = rig.channel[i];
+      if (!ch || ch->mNumRotationKeys < 3) continue;
+      auto q = [&](int k) {
+        const auto& v = ch->mRotationKeys[k].mValue;
+        return Quat(v.w, v.x, v.y, v.z).normalized();
+      };
+      j01 = std::max(j01, q(0).angularDistance(q(1)));
+      j12 = std::max(j12, q(1).angularDistance(q(2)));
+      t1 = ch->mRotationKeys[1].mTime / (anim->mTicksPerSecond > 0 ? anim->mTicksPerSecond : 25.0);
+    }
+    if (t1 > 0 && j01 > 20 * M_PI / 180 && j01 > 5 * j12) t0 = t1;
+  }
+  const double duration = anim->mDuration / tps - t0;
   if (opt.start_seconds > duration) fail(path, "start_seconds beyond the clip length " + std::to_string(duration) + " s");
   double end = duration;
   if (opt.max_seconds >= 0) end = std::min(end, opt.start_seconds + opt.max_seconds);
@@ -291,7 +309,7 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
   auto motion_local = [&](double seconds) {
     std::vector<Trs> L(rig.rest);
     for (size_t i = 0; i < nn; ++i)
-      if (rig.channel[i]) L[i] = sample(rig.channel[i], seconds * tps, rig.rest[i]);
+      if (rig.channel[i]) L[i] = sample(rig.channel[i], (t0 + seconds) * tps, rig.rest[i]);
     return L;
   };
   const std::vector<Trs> first = motion_local(opt.start_seconds);
@@ -303,6 +321,7 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
   // Body surface and skin.
   Skin sk;
   detail::SkinnedBody sb;
+  Mat4 shape_to_rest = Mat4::Identity();  // skeleton bodies: landmark space -> rest pose
   if (skinned) {
     sk = skin_from_meshes(s, rig, path);
     weld(sk, sk.apply(G_rest));
@@ -314,6 +333,10 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
       if (rig.channel[i]) root = static_cast<int>(i);
     if (root < 0) fail(path, "no animated node (no skeleton)");
     while (rig.parent[root] >= 0 && rig.channel[rig.parent[root]]) root = rig.parent[root];
+    // The body is built at the file's rest pose with its own root translation, so the same
+    // skeleton always gives the same mesh whatever start_seconds is.
+    const std::vector<Mat4> G_shape = rig.globals(rig.rest);
+    shape_to_rest = G_rest[root] * G_shape[root].inverse();
     std::vector<detail::SkelNode> nodes;
     std::vector<int> to_rig;
     std::map<int, int> from_rig;
@@ -325,7 +348,7 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
       detail::SkelNode sn;
       sn.name = rig.node[i]->mName.C_Str();
       sn.parent = static_cast<int>(i) == root ? -1 : from_rig[p];
-      sn.pos = G_rest[i].topRightCorner<3, 1>();
+      sn.pos = G_shape[i].topRightCorner<3, 1>();
       nodes.push_back(sn);
     }
     if (nodes.size() < 3) fail(path, "skeleton has fewer than 3 joints");
@@ -340,7 +363,7 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
     sk.start = sb.skin_start;
     for (size_t k = 0; k < nodes.size(); ++k) {
       sk.mat_node.push_back(to_rig[k]);
-      sk.mat_bind.push_back(G_rest[to_rig[k]].inverse());
+      sk.mat_bind.push_back(G_shape[to_rig[k]].inverse());
     }
     sk.mat = sb.skin_node;
     sk.weight = sb.skin_weight;
@@ -406,11 +429,14 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
   BodyLandmarks& lm = seq.landmarks;
   lm.height = opt.height;
   const TriMesh rest{seq.rest_V, seq.F};
-  auto out_pt = [&](const Vec3& p) { return Vec3((p - shift) * scale); };
+  auto out_pt = [&](const Vec3& p) {
+    const Vec3 q = (shape_to_rest * p.homogeneous()).head<3>();
+    return Vec3((q - shift) * scale);
+  };
   Vec3 hip_c, waist_c, chest_c;
   if (!skinned) {
     hip_c = out_pt(sb.hip_c), waist_c = out_pt(sb.waist_c), chest_c = out_pt(sb.chest_c);
-    lm.shoulder_y = out_pt(Vec3(0, sb.shoulder_y, 0)).y();
+    lm.shoulder_y = out_pt(Vec3(sb.chest_c.x(), sb.shoulder_y, sb.chest_c.z())).y();
   } else {
     const double H = opt.height;
     hip_c = Vec3(0, 0.52 * H, 0), waist_c = Vec3(0, 0.61 * H, 0), chest_c = Vec3(0, 0.72 * H, 0);

@@ -5,7 +5,8 @@
 //   by position). Closedness is whatever the file's mesh is.
 // - Bare skeleton (BVH, or no skinned mesh): a smooth body is built around the bones once
 //   at the rest pose (smooth union of tapered/elliptic capsules and ellipsoids, meshed by
-//   CGAL's surface mesher: closed, manifold, outward normals) and skinned to the bones.
+//   marching tetrahedra + CGAL isotropic remeshing: closed, manifold, outward normals,
+//   deterministic) and skinned to the bones (<= 4 per vertex, by distance to the parts).
 //
 // Output coordinates: metres, y up. Every body is scaled uniformly so that its rest pose is
 // opt.height tall (y extent; for skeleton bodies counting the legs as vertical, so a rest
@@ -18,7 +19,8 @@
 // smoothstep weight. The rest pose keeps each animated node's translation from the first
 // motion frame (so the body does not jump), with the rotations/scales of the file's rest
 // (offset/bind) pose. Then one frame per 1/fps seconds of the clip from start_seconds,
-// bone keys interpolated (positions lerp, rotations slerp).
+// bone keys interpolated (positions lerp, rotations slerp). Clip times (start_seconds,
+// max_seconds) count from the first motion key (see skip_calibration_key).
 #pragma once
 
 #include "gdsr/mesh.hpp"
@@ -34,9 +36,13 @@ struct BodyOptions {
   int rest_blend_frames = 15;   // frames blending from the rest pose into the first motion frame
   double start_seconds = 0.0;   // where in the clip to start
   double max_seconds = -1.0;    // clip length to use (<0: all)
-  // Skeleton bodies only: target triangle circumradius of the body mesh, metres (smaller =
-  // more triangles; 0.022 gives about 5k triangles for a 1.75 m body).
-  double body_edge = 0.022;
+  // Skeleton bodies only: target edge length of the body mesh, metres (smaller = more
+  // triangles; 0.028 gives about 6k triangles for a 1.75 m body).
+  double body_edge = 0.028;
+  // Mocap clips (e.g. CMU BVH) often start with one calibration T-pose key that jumps to
+  // the motion: when the first key differs from the second by a much larger rotation than
+  // the second from the third, the clip is taken to start at the second key.
+  bool skip_calibration_key = true;
 };
 
 // A horizontal cross-section of the rest-pose body (torso only: points within 0.35 m of

@@ -89,7 +89,7 @@ struct BodyQuery::Impl {
   void upload() {
     auto* vb = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
     const Eigen::Index n = mesh.V.rows();
-#pragma omp parallel for schedule(static) if (n > 4096)
+#pragma omp parallel for schedule(static) if (n > 50000)
     for (Eigen::Index i = 0; i < n; ++i)
       for (int k = 0; k < 3; ++k) vb[3 * i + k] = static_cast<float>(mesh.V(i, k));
     rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
@@ -104,7 +104,8 @@ struct BodyQuery::Impl {
     const Eigen::Index nf = mesh.F.rows(), nv = mesh.V.rows();
     fn.resize(nf, 3);
     Points3 acc = Points3::Zero(nv, 3);
-#pragma omp parallel for schedule(static)
+    // Bodies are small: threads only pay off for big meshes (and hurt on a loaded machine).
+#pragma omp parallel for schedule(static) if (nf > 50000)
     for (Eigen::Index f = 0; f < nf; ++f) {
       const Vec3 a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
       const Vec3 n = (b - a).cross(c - a);
@@ -124,13 +125,13 @@ struct BodyQuery::Impl {
       }
     }
     vn.resize(nv, 3);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nv > 50000)
     for (Eigen::Index i = 0; i < nv; ++i) {
       const double l = acc.row(i).norm();
       vn.row(i) = l > 0 ? Eigen::RowVector3d(acc.row(i) / l) : Eigen::RowVector3d::Zero();
     }
     en.resize(nf, 9);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nf > 50000)
     for (Eigen::Index f = 0; f < nf; ++f)
       for (int e = 0; e < 3; ++e) {
         Vec3 n = fn.row(f);
@@ -247,7 +248,7 @@ ClosestPoints BodyQuery::closest(const Points3& Q, bool smooth_normals, double m
   r.bary.resize(n, 3);
   const double inf = std::numeric_limits<double>::infinity();
   const float r0 = std::isinf(max_distance) ? inf : static_cast<float>(max_distance);
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, 64) if (n > 256)
   for (Eigen::Index i = 0; i < n; ++i) {
     PQData d{this, &m.mesh, Vec3(Q.row(i)), std::isinf(max_distance) ? inf : max_distance * max_distance, -1, 0,
              Vec3::Zero(), 0, 0, 0};
@@ -307,7 +308,7 @@ RayHits BodyQuery::intersect(const Points3& O, const Points3& D, double tmin, do
   r.uv.resize(n, 2);
   bool zero_dir = false;
   const float ftmax = std::isinf(tmax) ? std::numeric_limits<float>::infinity() : static_cast<float>(tmax);
-#pragma omp parallel for schedule(dynamic, 256)
+#pragma omp parallel for schedule(dynamic, 256) if (n > 1024)
   for (Eigen::Index i = 0; i < n; ++i) {
     if (D.row(i).squaredNorm() == 0) {
       zero_dir = true;

@@ -1,17 +1,13 @@
 // A human-like body around a bare skeleton: bones are classified by name (CMU/Mixamo
 // style names), limbs become tapered capsules, the torso a stack of elliptic capsules
 // through landmarks (hip joints, shoulder joints, neck), the head an ellipsoid. Their
-// smooth union is meshed once at the rest pose with CGAL's surface mesher (closed,
-// manifold); vertices are skinned to the bones owning the nearest primitives.
+// smooth union is meshed once at the rest pose (marching tetrahedra + CGAL isotropic
+// remeshing: closed, manifold, deterministic); vertices are skinned to the bones owning the nearest primitives.
 #include "gdsr/body_shape.hpp"
 
-#include <CGAL/Complex_2_in_triangulation_3.h>
-#include <CGAL/IO/facets_in_complex_2_to_triangle_mesh.h>
-#include <CGAL/Implicit_surface_3.h>
-#include <CGAL/Random.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <CGAL/Surface_mesh.h>
-#include <CGAL/Surface_mesh_default_triangulation_3.h>
-#include <CGAL/make_surface_mesh.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -19,6 +15,7 @@
 #include <cmath>
 #include <map>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace gdsr::detail {
 namespace {
@@ -278,47 +275,136 @@ SkinnedBody build_skeleton_body(const std::vector<SkelNode>& nodes_in, double mp
     return d;
   };
 
-  // CGAL surface mesher on the smooth union.
-  using Tr = CGAL::Surface_mesh_default_triangulation_3;
-  using C2t3 = CGAL::Complex_2_in_triangulation_3<Tr>;
-  using GT = Tr::Geom_traits;
-  using Point_3 = GT::Point_3;
-  using FT = GT::FT;
-  using Fn = std::function<FT(Point_3)>;
-  using Surface_3 = CGAL::Implicit_surface_3<GT, Fn>;
-  Vec3 centre = torso_ok ? Vec3(0.5 * (hip_mid + sh_mid)) : prims[0].a;
-  if (field(centre) >= 0) centre = prims[0].ellipsoid ? prims[0].a : 0.5 * (prims[0].a + prims[0].b);
-  double R = 0;
-  for (int i = 0; i < n; ++i) R = std::max(R, (P[i] - centre).norm());
-  R += 0.3;
-  // The mesher's initial points come from CGAL's (time-seeded) default random: fix it so the
-  // same skeleton always gives the same body.
-  CGAL::get_default_random() = CGAL::Random(20241122);
-  Tr tr;
-  C2t3 c2t3(tr);
-  Fn fn = [&](Point_3 q) { return FT(field(Vec3(q.x(), q.y(), q.z()))); };
-  Surface_3 surface(fn, GT::Sphere_3(Point_3(centre.x(), centre.y(), centre.z()), R * R), 1e-5);
-  CGAL::Surface_mesh_default_criteria_3<Tr> criteria(25.0, edge, edge * 0.12);
-  CGAL::make_surface_mesh(c2t3, surface, criteria, CGAL::Manifold_tag());
-  CGAL::Surface_mesh<Point_3> sm;
-  CGAL::facets_in_complex_2_to_triangle_mesh(c2t3, sm);
-  if (sm.number_of_faces() < 4) throw std::runtime_error("build_skeleton_body: meshing failed");
+  // Deterministic meshing: marching tetrahedra on a grid (closed, manifold piecewise-linear
+  // isosurface), then CGAL isotropic remeshing to the target edge length, then vertices
+  // projected back onto the smooth field.
+  Vec3 blo = Vec3::Constant(1e300), bhi = Vec3::Constant(-1e300);
+  for (const Prim& p : prims) {
+    const double rmax = p.ellipsoid ? p.r.maxCoeff() : std::max({p.rax, p.raz, p.rbx, p.rbz});
+    for (const Vec3& c : {p.a, p.ellipsoid ? p.a : p.b}) {
+      blo = blo.cwiseMin(c - Vec3::Constant(rmax));
+      bhi = bhi.cwiseMax(c + Vec3::Constant(rmax));
+    }
+  }
+  const double h = std::min(0.015, 0.6 * edge);
+  blo -= Vec3::Constant(2 * h);
+  bhi += Vec3::Constant(2 * h);
+  const int gx = static_cast<int>(std::ceil((bhi.x() - blo.x()) / h)) + 1;
+  const int gy = static_cast<int>(std::ceil((bhi.y() - blo.y()) / h)) + 1;
+  const int gz = static_cast<int>(std::ceil((bhi.z() - blo.z()) / h)) + 1;
+  auto gid = [&](int i, int j, int k) { return (static_cast<long long>(k) * gy + j) * gx + i; };
+  auto gpos = [&](long long g) {
+    const int i = static_cast<int>(g % gx), j = static_cast<int>((g / gx) % gy), k = static_cast<int>(g / (static_cast<long long>(gx) * gy));
+    return Vec3(blo.x() + i * h, blo.y() + j * h, blo.z() + k * h);
+  };
+  std::vector<double> val(static_cast<size_t>(gx) * gy * gz);
+#pragma omp parallel for schedule(dynamic)
+  for (int k = 0; k < gz; ++k)
+    for (int j = 0; j < gy; ++j)
+      for (int i = 0; i < gx; ++i) {
+        double f = field(Vec3(blo.x() + i * h, blo.y() + j * h, blo.z() + k * h));
+        if (f == 0) f = 1e-12;  // no vertex exactly on the surface
+        val[gid(i, j, k)] = f;
+      }
+  std::vector<Vec3> mv;
+  std::vector<std::array<int, 3>> mf;
+  std::unordered_map<long long, int> edge_vertex;
+  const long long ng = static_cast<long long>(gx) * gy * gz;
+  auto crossing = [&](long long a, long long b) {
+    if (a > b) std::swap(a, b);
+    auto [it, fresh] = edge_vertex.emplace(a * ng + b, static_cast<int>(mv.size()));
+    if (fresh) {
+      const double fa = val[a], fb = val[b];
+      mv.push_back(gpos(a) + (fa / (fa - fb)) * (gpos(b) - gpos(a)));
+    }
+    return it->second;
+  };
+  // Freudenthal split of the cube into 6 tetrahedra around the diagonal 0-7 (corner bits x=1, y=2, z=4).
+  static const int tets[6][4] = {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7}, {0, 6, 4, 7}, {0, 4, 5, 7}, {0, 5, 1, 7}};
+  auto emit = [&](int a, int b, int c, const Vec3& out_dir) {
+    const Vec3 n = (mv[b] - mv[a]).cross(mv[c] - mv[a]);
+    if (n.dot(out_dir) >= 0) mf.push_back({a, b, c});
+    else mf.push_back({a, c, b});
+  };
+  for (int k = 0; k + 1 < gz; ++k)
+    for (int j = 0; j + 1 < gy; ++j)
+      for (int i = 0; i + 1 < gx; ++i) {
+        long long g[8];
+        int neg = 0;
+        for (int c = 0; c < 8; ++c) {
+          g[c] = gid(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1));
+          neg += val[g[c]] < 0;
+        }
+        if (neg == 0 || neg == 8) continue;
+        for (const auto& t : tets) {
+          std::vector<long long> in, out;
+          for (int c : t) (val[g[c]] < 0 ? in : out).push_back(g[c]);
+          if (in.empty() || out.empty()) continue;
+          Vec3 dir = Vec3::Zero();
+          for (long long q : out) dir += gpos(q) / out.size();
+          for (long long q : in) dir -= gpos(q) / in.size();
+          if (in.size() == 1 || out.size() == 1) {
+            const long long lone = in.size() == 1 ? in[0] : out[0];
+            const auto& rest = in.size() == 1 ? out : in;
+            emit(crossing(lone, rest[0]), crossing(lone, rest[1]), crossing(lone, rest[2]), dir);
+          } else {
+            const int ac = crossing(in[0], out[0]), ad = crossing(in[0], out[1]);
+            const int bd = crossing(in[1], out[1]), bc = crossing(in[1], out[0]);
+            emit(ac, ad, bd, dir);
+            emit(ac, bd, bc, dir);
+          }
+        }
+      }
+  if (mf.size() < 4) throw std::runtime_error("build_skeleton_body: marching tetrahedra found no surface");
+
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  using SM = CGAL::Surface_mesh<K::Point_3>;
+  SM sm;
+  std::vector<SM::Vertex_index> vh;
+  vh.reserve(mv.size());
+  for (const Vec3& p : mv) vh.push_back(sm.add_vertex(K::Point_3(p.x(), p.y(), p.z())));
+  for (const auto& t : mf) {
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+    if (sm.add_face(vh[t[0]], vh[t[1]], vh[t[2]]) == SM::null_face())
+      throw std::runtime_error("build_skeleton_body: marching tetrahedra produced a non-manifold face");
+  }
+  namespace PMP = CGAL::Polygon_mesh_processing;
+  PMP::isotropic_remeshing(faces(sm), edge, sm, CGAL::parameters::number_of_iterations(4));
+  sm.collect_garbage();
+  if (sm.number_of_faces() < 4) throw std::runtime_error("build_skeleton_body: remeshing failed");
 
   const int nv = static_cast<int>(sm.number_of_vertices());
   Points3 V(nv, 3);
-  std::map<std::size_t, int> vid;
-  int k = 0;
   for (auto v : sm.vertices()) {
     const auto& q = sm.point(v);
-    V.row(k) << q.x(), q.y(), q.z();
-    vid[static_cast<std::size_t>(v)] = k++;
+    V.row(static_cast<int>(v.idx())) << q.x(), q.y(), q.z();
   }
   Faces F(sm.number_of_faces(), 3);
-  k = 0;
+  int k = 0;
   for (auto f : sm.faces()) {
     int j = 0;
-    for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm)) F(k, j++) = vid[static_cast<std::size_t>(v)];
+    for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm)) F(k, j++) = static_cast<int>(v.idx());
     ++k;
+  }
+  // Newton steps onto the zero set of the smooth field (central-difference gradient).
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < nv; ++i) {
+    Vec3 p = V.row(i);
+    for (int it = 0; it < 3; ++it) {
+      const double f = field(p), e = 1e-4;
+      Vec3 g;
+      for (int c = 0; c < 3; ++c) {
+        Vec3 d = Vec3::Zero();
+        d[c] = e;
+        g[c] = (field(p + d) - field(p - d)) / (2 * e);
+      }
+      const double gg = g.squaredNorm();
+      if (!(gg > 1e-8)) break;
+      Vec3 step = g * (f / gg);
+      if (step.norm() > 0.25 * edge) step *= 0.25 * edge / step.norm();
+      p -= step;
+    }
+    V.row(i) = p.transpose();
   }
   // Outward orientation: positive signed volume.
   double vol = 0;

@@ -1,5 +1,6 @@
 #include "gdsr/collision.hpp"
 
+#include "gdsr/body_query.hpp"
 #include "gdsr/mesh_ops.hpp"
 
 #include <nanoflann.hpp>
@@ -57,6 +58,14 @@ int push_group(const Groups& g, int i, const Vec3& p, const Vec3& n, double sigm
 }
 
 }  // namespace
+
+BodyQueryFn body_query_fn(const BodyQuery& body) {
+  return [&body](const Points3& q, Points3& closest, Points3& normal) {
+    ClosestPoints c = body.closest(q, true);
+    closest = std::move(c.point);
+    normal = std::move(c.normal);
+  };
+}
 
 CollisionStats resolve_collisions(const CollisionConfig& cfg, const CollisionInput& in, Points3& G) {
   if (in.C_hat == nullptr || in.hr_nearest_lr == nullptr) fail("C_hat and hr_nearest_lr are required");

@@ -35,6 +35,11 @@ struct CollisionConfig {
 // Closest body surface point and its outward unit normal for each query row (N x 3 each).
 using BodyQueryFn = std::function<void(const Points3& queries, Points3& closest, Points3& normal)>;
 
+class BodyQuery;
+// Adapter for an Embree body (gdsr/body_query.hpp): closest points with the smooth body
+// normal (the n_b of the graph features). The BodyQuery must outlive the function.
+BodyQueryFn body_query_fn(const BodyQuery& body);
+
 struct CollisionStats {
   int lr_body = 0;   // LR vertices colliding with the body
   int hr_body = 0;   // HR vertices moved by the body pass

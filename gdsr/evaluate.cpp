@@ -31,7 +31,11 @@ cv::Mat uv_normal_map(const UVRaster& raster, const Faces& F, const Points3& V) 
 
 double ssim(const cv::Mat& a, const cv::Mat& b) {
   if (a.size() != b.size() || a.type() != b.type()) throw std::runtime_error("ssim: images differ in size or type");
-  const cv::Scalar s = cv::quality::QualitySSIM::compute(a, b, cv::noArray());
+  // OpenCV's SSIM constants C1 = (0.01 * 255)^2, C2 = (0.03 * 255)^2 assume 0..255 pixels.
+  cv::Mat a255, b255;
+  a.convertTo(a255, CV_32F, 255.0);
+  b.convertTo(b255, CV_32F, 255.0);
+  const cv::Scalar s = cv::quality::QualitySSIM::compute(a255, b255, cv::noArray());
   return (s[0] + s[1] + s[2]) / 3.0;
 }
 

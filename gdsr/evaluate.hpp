@@ -15,7 +15,8 @@ namespace gdsr {
 // renormalised, as in training); background black. CV_32FC3 in 0..1, RGB = xyz.
 cv::Mat uv_normal_map(const UVRaster& raster, const Faces& F, const Points3& V);
 
-// Mean SSIM over the three channels (OpenCV quality module, Gaussian window 11, sigma 1.5).
+// Mean SSIM over the three channels (OpenCV quality module, Gaussian window 11, sigma 1.5)
+// of two CV_32FC3 images with values in 0..1.
 double ssim(const cv::Mat& a, const cv::Mat& b);
 
 // Appendix B: per triangle E_u = (|w_u| - 1)^2, E_v = (|w_v| - 1)^2, E_uv = (w_u . w_v)^2

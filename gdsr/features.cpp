@@ -3,6 +3,8 @@
 #include "autograd/autograd.hpp"
 #include "gdsr/model_geometry.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <limits>
 #include <stdexcept>

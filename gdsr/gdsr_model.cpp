@@ -95,22 +95,43 @@ GdsrOutput<T> GDSR<T>::decode(const GarmentGraph& g, const ag::Tensor<T>& C_t, c
   for (int f = 0; f < g.num_faces(); ++f)
     if (row_of[f] >= 0) row_of[f] = static_cast<int64_t>(out.faces.size()), out.faces.push_back(f);
   out.group.resize(N);
-  ag::Index corners(3 * static_cast<size_t>(N));
-  for (int i = 0; i < N; ++i) {
-    out.group[i] = row_of[hr->tri[i]];
-    for (int k = 0; k < 3; ++k) corners[3 * i + k] = g.F(hr->tri[i], k);
+  for (int i = 0; i < N; ++i) out.group[i] = row_of[hr->tri[i]];
+  // The field runs on the samples sorted by triangle (grouped_linear then works in place);
+  // `order` is that permutation, `back` restores the request's order at the end.
+  ag::Index order(N), back;
+  for (int i = 0; i < N; ++i) order[i] = i;
+  const bool sorted = std::is_sorted(out.group.begin(), out.group.end());
+  if (!sorted) {
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int64_t a, int64_t b) { return out.group[a] < out.group[b]; });
+    back.resize(N);
+    for (int i = 0; i < N; ++i) back[order[i]] = i;
   }
-  const ag::Tensor<T> bary = ag::Tensor<T>::from_eigen(hr->bary.cast<T>());
+  ag::Index group(N), corners(3 * static_cast<size_t>(N));
+  ag::Tensor<T> bary = ag::Tensor<T>::zeros({N, 3});
+  for (int i = 0; i < N; ++i) {
+    const int64_t s = order[i];
+    group[i] = out.group[s];
+    for (int k = 0; k < 3; ++k) {
+      corners[3 * i + k] = g.F(hr->tri[s], k);
+      bary.data()[3 * i + k] = T(hr->bary(s, k));
+    }
+  }
+  auto restore = [&](const ag::Tensor<T>& x) { return sorted ? x : ag::index_select_rows(x, back); };
 
   t0 = Clock::now();
   out.field = a_->parameters_for(gather_face_features(g.F, out.faces, ag::slice_cols(z, 0, zd)));
   if (timings) timings->a += since(t0);
   t0 = Clock::now();
-  out.residual_local = a_->eval_field(out.field, bary, out.group);
+  const ag::Tensor<T> r_local = a_->eval_field(out.field, bary, group);
   const ag::Tensor<T> frames = triangle_frames_ad(out.C_hat, g.F, out.faces, T(cfg_.frame_eps));
-  out.residual = local_to_world(out.residual_local, ag::index_select_rows(frames, out.group));
-  out.upsampled = ag::interpolate_rows(out.C_hat, corners, bary);
-  out.G = ag::add(out.upsampled, out.residual);
+  const ag::Tensor<T> r_world = local_to_world(r_local, ag::index_select_rows(frames, group));
+  const ag::Tensor<T> up = ag::interpolate_rows(out.C_hat, corners, bary);
+  const ag::Tensor<T> G = ag::add(up, r_world);
+  out.residual_local = restore(r_local);
+  out.residual = restore(r_world);
+  out.upsampled = restore(up);
+  out.G = restore(G);
   if (timings) timings->field += since(t0);
   return out;
 }

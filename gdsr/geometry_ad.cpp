@@ -7,6 +7,8 @@
 #include "autograd/ops_vec3.hpp"
 #include "gdsr/mesh_ops.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>

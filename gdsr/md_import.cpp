@@ -6,8 +6,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace gdsr {
 namespace fs = std::filesystem;
@@ -53,6 +55,20 @@ std::vector<ObjData> read_sequence(const std::string& dir, const std::string& wh
 
 size_t count_objs(const std::string& dir) { return list_frame_objs(dir).size(); }
 
+// Applies a weld map to a sequence: faces re-indexed (first frame), positions compacted.
+void weld_sequence(std::vector<ObjData>& seq, const std::vector<int>& map, int count, const std::string& what) {
+  for (int f = 0; f < seq[0].F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) seq[0].F(f, k) = map[seq[0].F(f, k)];
+    if (seq[0].F(f, 0) == seq[0].F(f, 1) || seq[0].F(f, 1) == seq[0].F(f, 2) || seq[0].F(f, 0) == seq[0].F(f, 2))
+      fail(what + ": welding collapses triangle " + std::to_string(f) + " (weld distance too large)");
+  }
+  for (ObjData& d : seq) {
+    Points3 V(count, 3);
+    for (int i = static_cast<int>(map.size()) - 1; i >= 0; --i) V.row(map[i]) = d.V.row(i);
+    d.V = std::move(V);
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> list_frame_objs(const std::string& dir) {
@@ -70,6 +86,37 @@ std::vector<std::string> list_frame_objs(const std::string& dir) {
   std::vector<std::string> out;
   for (auto& f : files) out.push_back(f.second);
   return out;
+}
+
+std::vector<int> weld_map(const Points3& V, double eps, int& count) {
+  if (!(eps > 0)) fail("weld distance must be positive");
+  auto key = [&](long x, long y, long z) { return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791); };
+  std::unordered_map<long, std::vector<int>> grid;
+  std::vector<int> map(static_cast<size_t>(V.rows()), -1);
+  count = 0;
+  for (int i = 0; i < V.rows(); ++i) {
+    const long cx = static_cast<long>(std::floor(V(i, 0) / eps)), cy = static_cast<long>(std::floor(V(i, 1) / eps)),
+               cz = static_cast<long>(std::floor(V(i, 2) / eps));
+    int rep = -1;
+    for (long dx = -1; dx <= 1 && rep < 0; ++dx)
+      for (long dy = -1; dy <= 1 && rep < 0; ++dy)
+        for (long dz = -1; dz <= 1 && rep < 0; ++dz) {
+          auto it = grid.find(key(cx + dx, cy + dy, cz + dz));
+          if (it == grid.end()) continue;
+          for (int j : it->second)
+            if ((V.row(i) - V.row(j)).norm() <= eps) {
+              rep = j;
+              break;
+            }
+        }
+    if (rep >= 0) {
+      map[i] = map[rep];
+    } else {
+      map[i] = count++;
+      grid[key(cx, cy, cz)].push_back(i);
+    }
+  }
+  return map;
 }
 
 GarmentMesh garment_from_flat(const ObjData& flat, const ObjData& frame, const std::string& what) {
@@ -106,6 +153,13 @@ Dataset import_md(const MdImportOptions& opt) {
   Dataset d;
   std::vector<ObjData> lr = read_sequence(opt.lr_dir, "LR", done, total, opt.progress);
   std::vector<ObjData> hr = read_sequence(opt.hr_dir, "HR", done, total, opt.progress);
+  if (opt.weld > 0) {
+    int n = 0;
+    const std::vector<int> lm = weld_map(lr[0].V * opt.scale, opt.weld, n);
+    weld_sequence(lr, lm, n, opt.lr_dir);
+    const std::vector<int> hm = weld_map(hr[0].V * opt.scale, opt.weld, n);
+    weld_sequence(hr, hm, n, opt.hr_dir);
+  }
   d.lr = garment_from_flat(read_obj(opt.lr_uv), lr[0], opt.lr_uv);
   d.hr = garment_from_flat(read_obj(opt.hr_uv), hr[0], opt.hr_uv);
   for (GarmentMesh* g : {&d.lr, &d.hr}) {

@@ -23,6 +23,8 @@ struct MdImportOptions {
   std::string garment = "imported";
   double fps = 30;     // frames per second of the exports
   double scale = 1.0;  // file units -> metres
+  double weld = 0;     // > 0: merge 3-D vertices of the first frame closer than this (metres),
+                       // for exports written unwelded; 0 = the 3-D OBJs are already welded
   int raster_size = 1024;
   ProgressFn progress;  // (frames read, total frames)
 };
@@ -32,6 +34,11 @@ Dataset import_md(const MdImportOptions& opt);
 // *.obj files of a folder sorted by the last integer in the name (then by name); throws if
 // the folder is missing or holds none.
 std::vector<std::string> list_frame_objs(const std::string& dir);
+
+// Welding map of V: each vertex joins the first earlier kept vertex within eps (hash grid of
+// cell eps), otherwise it is kept. Returns old vertex -> new compact index (kept vertices in
+// their original order); count = number of kept vertices.
+std::vector<int> weld_map(const Points3& V, double eps, int& count);
 
 // A garment from its flattened OBJ (UV layout in "v") and one 3-D frame (welded V, F).
 GarmentMesh garment_from_flat(const ObjData& flat, const ObjData& frame, const std::string& what);

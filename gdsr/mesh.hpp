@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // Vec3::cross
 #include <string>
 #include <vector>
 

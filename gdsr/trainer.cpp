@@ -170,9 +170,8 @@ TrainResult train_gdsr(const std::vector<const Dataset*>& data, const TrainOptio
     L.lambda_c = lambdas.coarse;
     L.lambda_w = lambdas.fine;
     L.lr = adam.lr();
-    for (const auto& [k, v] : coarse.log()) L.terms["coarse/" + k] = v;
-    if (opt.fine)
-      for (const auto& [k, v] : fine.log()) L.terms["fine/" + k] = v;
+    L.terms = coarse.log();  // keys c_position, c_normal, ...
+    if (opt.fine) L.terms.merge(fine.log());  // f_position, f_vgg, ...
 
     if (!std::isfinite(value))
       throw std::runtime_error("training stopped at step " + std::to_string(step + 1) + ": the loss is " +

@@ -58,6 +58,7 @@ UVHit closest_on_triangle(const Vec2& p, const Vec2& a, const Vec2& b, const Vec
 UVLocator::UVLocator(const Points2& UV, const Faces& FUV) : uv_(UV), f_(FUV) {
   if (UV.rows() == 0 || FUV.rows() == 0) throw std::runtime_error("uv locator: empty UV layout");
   if (FUV.minCoeff() < 0 || FUV.maxCoeff() >= UV.rows()) throw std::runtime_error("uv locator: UV face index out of range");
+  if (!UV.allFinite()) throw std::runtime_error("uv locator: NaN or infinite UV coordinate");
   const Vec2 lo = UV.colwise().minCoeff().transpose(), hi = UV.colwise().maxCoeff().transpose();
   double ext_sum = 0;
   for (int f = 0; f < FUV.rows(); ++f) {
@@ -107,6 +108,7 @@ void UVLocator::visit_cell(int cx, int cy, const Vec2& p, UVHit& best) const {
 }
 
 UVHit UVLocator::locate(const Vec2& p) const {
+  if (!p.allFinite()) throw std::runtime_error("uv locator: NaN or infinite query point");
   const int cx = std::clamp(static_cast<int>(std::floor((p.x() - x0_) / cell_)), 0, nx_ - 1);
   const int cy = std::clamp(static_cast<int>(std::floor((p.y() - y0_) / cell_)), 0, ny_ - 1);
   UVHit best;

@@ -7,6 +7,7 @@
 
 #include "autograd/tensor.hpp"
 
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -49,54 +50,65 @@ template <class T> class Module {
  protected:
   ag::Tensor<T>& register_parameter(const std::string& name, ag::Tensor<T> t) {
     check_name(name);
+    if (!t.defined()) throw ag::Error("Module::register_parameter: undefined tensor '" + name + "'");
     t.set_requires_grad(true);
-    params_.emplace_back(name, std::move(t));
-    return params_.back().second;
+    entries_.push_back(Entry{name, std::move(t), nullptr});
+    return entries_.back().param;
   }
   template <class M> std::shared_ptr<M> register_module(const std::string& name, std::shared_ptr<M> m) {
     check_name(name);
     if (!m) throw ag::Error("Module::register_module: null module '" + name + "'");
-    children_.emplace_back(name, std::static_pointer_cast<Module<T>>(m));
+    entries_.push_back(Entry{name, ag::Tensor<T>(), std::static_pointer_cast<Module<T>>(m)});
     return m;
   }
 
  private:
+  struct Entry {  // a parameter or a child module
+    std::string name;
+    ag::Tensor<T> param;
+    std::shared_ptr<Module<T>> child;
+  };
   void check_name(const std::string& name) const {
     if (name.empty() || name.find('.') != std::string::npos)
       throw ag::Error("Module: invalid name '" + name + "' (non-empty, no dots)");
-    for (auto& p : params_)
-      if (p.first == name) throw ag::Error("Module: duplicate parameter name '" + name + "'");
-    for (auto& c : children_)
-      if (c.first == name) throw ag::Error("Module: duplicate child name '" + name + "'");
+    for (auto& e : entries_)
+      if (e.name == name) throw ag::Error("Module: duplicate name '" + name + "'");
   }
   void collect(const std::string& prefix, std::vector<std::pair<std::string, ag::Tensor<T>>>& out) const {
-    for (auto& [n, t] : params_) out.emplace_back(prefix + n, t);
-    for (auto& [n, c] : children_) c->collect(prefix + n + ".", out);
+    for (auto& e : entries_) {
+      if (e.child)
+        e.child->collect(prefix + e.name + ".", out);
+      else
+        out.emplace_back(prefix + e.name, e.param);
+    }
   }
 
-  // std::vector of pairs: register_parameter's reference is only valid until the next
-  // registration; layers copy the handle into their members right away.
-  std::vector<std::pair<std::string, ag::Tensor<T>>> params_;
-  std::vector<std::pair<std::string, std::shared_ptr<Module<T>>>> children_;
+  // register_parameter's reference is only valid until the next registration; layers
+  // copy the handle into their members right away.
+  std::vector<Entry> entries_;
 };
 
 // Copies parameter values between modules of the same architecture (e.g. float <-> double),
 // matched by name; throws when names or shapes differ.
 template <class A, class B> void copy_parameters(const Module<A>& from, Module<B>& to) {
-  auto src = from.named_parameters();
+  const auto src = from.named_parameters();
   auto dst = to.named_parameters();
   if (src.size() != dst.size())
-    throw ag::Error("copy_parameters: " + std::to_string(src.size()) + " parameters vs " +
-                    std::to_string(dst.size()));
-  for (size_t i = 0; i < src.size(); ++i) {
-    if (src[i].first != dst[i].first)
-      throw ag::Error("copy_parameters: parameter " + std::to_string(i) + " is '" + src[i].first +
-                      "' in the source and '" + dst[i].first + "' in the destination");
-    if (src[i].second.shape() != dst[i].second.shape())
-      throw ag::Error("copy_parameters: '" + src[i].first + "' has shape " +
-                      ag::shape_str(src[i].second.shape()) + " vs " + ag::shape_str(dst[i].second.shape()));
-    const auto& s = src[i].second.values();
-    auto& d = dst[i].second.values();
+    throw ag::Error("copy_parameters: " + std::to_string(src.size()) + " parameters in the source vs " +
+                    std::to_string(dst.size()) + " in the destination");
+  std::map<std::string, const ag::Tensor<A>*> by_name;
+  for (const auto& [n, t] : src) by_name[n] = &t;
+  // Check everything first, so that a refused copy leaves the destination unchanged.
+  for (const auto& [n, t] : dst) {
+    const auto it = by_name.find(n);
+    if (it == by_name.end()) throw ag::Error("copy_parameters: '" + n + "' is not in the source");
+    if (it->second->shape() != t.shape())
+      throw ag::Error("copy_parameters: '" + n + "' has shape " + ag::shape_str(it->second->shape()) + " vs " +
+                      ag::shape_str(t.shape()));
+  }
+  for (auto& [n, t] : dst) {
+    const auto& s = by_name[n]->values();
+    auto& d = t.values();
     for (size_t k = 0; k < s.size(); ++k) d[k] = static_cast<B>(s[k]);
   }
 }

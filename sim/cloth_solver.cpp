@@ -162,7 +162,9 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
     for (int v = 0; v < nv; ++v) {
       if (winv_[v] == 0) continue;
       const SurfaceHit hit = grid_.closest(x_.row(v).transpose(), body_now, r);
-      if (hit.face >= 0) contacts_.push_back({v, hit.face, hit.bary});
+      // Deeper than max_push: the vertex went through a thin part or is pinched (e.g. between
+      // an arm and the pinned waistband); pushing it out would tear the cloth, so leave it.
+      if (hit.face >= 0 && hit.signed_distance > -p_.max_push) contacts_.push_back({v, hit.face, hit.bary});
     }
   }
   layer_pairs_.clear();

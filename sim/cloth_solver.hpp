@@ -18,7 +18,7 @@
 namespace sim {
 
 struct SimParams {
-  int substeps = 20;             // per body frame
+  int substeps = 40;             // per body frame (HR at 10 mm needs ~40 to buckle into wrinkles)
   int iterations = 1;            // constraint passes per substep
   double thickness = 0.004;      // m, cloth kept this far outside the body
   double friction = 0.3;         // Coulomb coefficient against the body
@@ -30,6 +30,7 @@ struct SimParams {
   double layer_gap = 0.004;      // m, outer layer kept this far outside the inner layer
   double contact_radius = 0.03;  // m, body search radius beyond thickness
   int contact_every = 5;         // substeps between contact refreshes
+  double max_push = 0.02;        // m, vertices deeper than this inside the body are not pushed out
   double max_speed = 15;         // m/s, velocity clamp (safety against fast body parts)
   int settle_frames = 15;        // frames simulated on the first body pose before frame 0
 };

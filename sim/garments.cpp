@@ -115,29 +115,52 @@ BodyLandmarks measure_body(const gdsr::TriMesh& b) {
   lm.height = b.V.col(1).maxCoeff() - lm.floor;
   if (!(lm.height > 0.3)) fail("body is shorter than 0.3 m (expected metres, Y up)");
   const double H = lm.height, s = H / 1.75;
-  lm.waist_y = lm.floor + 0.61 * H;
-  lm.hip_y = lm.floor + 0.52 * H;
-  lm.crotch_y = lm.floor + 0.47 * H;
   lm.armpit_y = lm.floor + 0.73 * H;
   lm.shoulder_y = lm.floor + 0.81 * H;
   lm.neck_y = lm.floor + 0.85 * H;
-  // Trunk axis: mean x, z of the vertices around the waist.
+  // Trunk axis: mean x, z of the vertices around mid-height of the trunk.
   Vec3 c = Vec3::Zero();
   int n = 0;
   for (int v = 0; v < b.V.rows(); ++v)
-    if (std::abs(b.V(v, 1) - lm.waist_y) < 0.03 * s) {
+    if (std::abs(b.V(v, 1) - (lm.floor + 0.62 * H)) < 0.03 * s) {
       c += b.V.row(v).transpose();
       ++n;
     }
-  if (n == 0) fail("body has no trunk at waist height");
+  if (n == 0) fail("body has no trunk at 0.62 of its height");
   lm.axis = c / n;
-  const double slab = 0.02 * s, max_r = 0.28 * s;
-  lm.waist_r = radial_extent(b, lm.axis, lm.waist_y, slab, max_r);
+  const double slab = 0.015 * s, max_r = 0.28 * s;
+  // Crotch: highest height below 0.56 H where no vertex lies near the mid-plane x = axis.
+  lm.crotch_y = lm.floor + 0.47 * H;
+  for (double y = lm.floor + 0.56 * H; y > lm.floor + 0.35 * H; y -= 0.005 * s) {
+    bool mid = false;
+    for (int v = 0; v < b.V.rows() && !mid; ++v)
+      mid = std::abs(b.V(v, 1) - y) < 0.02 * s && std::abs(b.V(v, 0) - lm.axis.x()) < 0.03 * s;
+    if (!mid) {
+      lm.crotch_y = y;
+      break;
+    }
+  }
+  // Waist: narrowest trunk section between crotch + 0.17 H and 0.72 H; hips: widest below.
+  lm.waist_y = lm.floor + 0.61 * H;
+  lm.waist_r = 1e9;
+  for (double y = lm.crotch_y + 0.17 * H; y <= lm.floor + 0.72 * H; y += 0.005 * s) {
+    const double r = radial_extent(b, lm.axis, y, slab, max_r);
+    if (r > 0 && r < lm.waist_r) {
+      lm.waist_r = r;
+      lm.waist_y = y;
+    }
+  }
+  if (!(lm.waist_r < 1e9)) fail("body has no trunk at waist height");
   lm.hip_r = lm.waist_r;
-  for (double y = lm.crotch_y + 0.02 * s; y <= lm.waist_y; y += 0.01 * s)
-    lm.hip_r = std::max(lm.hip_r, radial_extent(b, lm.axis, y, slab, max_r));
+  lm.hip_y = lm.waist_y;
+  for (double y = lm.crotch_y + 0.03 * s; y <= lm.waist_y; y += 0.005 * s) {
+    const double r = radial_extent(b, lm.axis, y, slab, max_r);
+    if (r > lm.hip_r) {
+      lm.hip_r = r;
+      lm.hip_y = y;
+    }
+  }
   lm.chest_r = std::max(radial_extent(b, lm.axis, lm.floor + 0.70 * H, slab, 0.24 * s), lm.waist_r);
-  if (lm.waist_r <= 0) fail("body has no trunk at waist height");
   lm.shoulder_halfwidth = 0.19 * s;
   // Legs: vertices right of the axis at thigh height.
   double sx = 0;
@@ -291,21 +314,24 @@ Garment make_garment(const std::string& name, double h, const gdsr::TriMesh& bod
     const double hem_y = lm.crotch_y - 0.16 * s;
     const double Htot = lm.waist_y - hem_y;
     const double Hc = lm.crotch_y - 0.03 * s - hem_y;
-    const double g = 0.02 * s, blend = 0.08 * s;
+    const double g = 0.02 * s, blend = 0.10 * s;
     place_pattern(pm, [&](int panel, const Vec2& uv) {
       const double x = uv.x() - panel * (W + 0.1), y = uv.y();
       const double psi = x / R + panel * kPi;
       const Vec3 hip(R * std::sin(psi), hem_y + y, R * std::cos(psi));
-      if (y >= Hc) return Vec3(axis + hip);
+      if (y >= Hc + blend) return Vec3(axis + hip);
       // Leg tube: side seam (t = 0) outside, inseam (t = 1) inside, front/back at t = 1/2.
-      const double gy = g * (1 - y / Hc);
+      // Between the crotch and crotch + blend the tubes blend into the hip cylinder, so the
+      // crotch point sits between the legs.
+      const double gy = g * std::max(0.0, 1 - y / Hc);
       const double wleg = W / 2 - gy;
       const double t = std::clamp((W / 2 - std::abs(x)) / wleg, 0.0, 1.0);
       const double r = wleg / kPi;
       const double side = (x >= 0) == (panel == 0) ? 1.0 : -1.0;  // 3-D x side of this leg
       const double zs = panel == 0 ? 1.0 : -1.0;
       const Vec3 leg(side * (R / 2 + r * std::cos(kPi * t)), hem_y + y, zs * r * std::sin(kPi * t));
-      const double b = std::clamp((y - (Hc - blend)) / blend, 0.0, 1.0);
+      const double u = std::clamp((y - Hc) / blend, 0.0, 1.0);
+      const double b = u * u * (3 - 2 * u);
       return Vec3(axis + (1 - b) * leg + b * hip);
     });
     for (int u = 0; u < pm.mesh.UV.rows(); ++u) pin_uv[u] = pm.mesh.UV(u, 1) > Htot - 1e-9;

@@ -103,6 +103,60 @@ WrinkleMeasure wrinkle_measure(const Points3& X, const gdsr::Faces& F) {
   return w;
 }
 
+Points3 resample_by_uv(const gdsr::GarmentMesh& from, const Points3& from_X, const gdsr::GarmentMesh& to) {
+  if (from_X.rows() != from.V.rows()) throw std::runtime_error("sim/sim_metrics: positions do not match the source garment");
+  // Uniform grid over the source UV triangles' boxes.
+  const double cell = 0.05;
+  std::map<std::pair<int, int>, std::vector<int>> grid;
+  for (int f = 0; f < from.FUV.rows(); ++f) {
+    Vec2 lo = from.UV.row(from.FUV(f, 0)), hi = lo;
+    for (int k = 1; k < 3; ++k) {
+      lo = lo.cwiseMin(Vec2(from.UV.row(from.FUV(f, k))));
+      hi = hi.cwiseMax(Vec2(from.UV.row(from.FUV(f, k))));
+    }
+    for (int i = static_cast<int>(std::floor(lo.x() / cell)); i <= static_cast<int>(std::floor(hi.x() / cell)); ++i)
+      for (int j = static_cast<int>(std::floor(lo.y() / cell)); j <= static_cast<int>(std::floor(hi.y() / cell)); ++j)
+        grid[{i, j}].push_back(f);
+  }
+  Points3 out = Points3::Zero(to.V.rows(), 3);
+  std::vector<int> count(to.V.rows(), 0);
+  for (int u = 0; u < to.UV.rows(); ++u) {
+    const Vec3 q(to.UV(u, 0), to.UV(u, 1), 0);
+    double best = 1e300;
+    int bf = -1;
+    Vec3 bb = Vec3::Zero();
+    const int ci = static_cast<int>(std::floor(q.x() / cell)), cj = static_cast<int>(std::floor(q.y() / cell));
+    int found_ring = -1;
+    for (int ring = 0; ring < 2000; ++ring) {  // square rings of cells; one extra ring after a hit
+      for (int i = ci - ring; i <= ci + ring; ++i)
+        for (int j = cj - ring; j <= cj + ring; ++j) {
+          if (std::max(std::abs(i - ci), std::abs(j - cj)) != ring) continue;
+          auto it = grid.find({i, j});
+          if (it == grid.end()) continue;
+          for (int f : it->second) {
+            auto p3 = [&](int k) { return Vec3(from.UV(from.FUV(f, k), 0), from.UV(from.FUV(f, k), 1), 0); };
+            const Vec3 b = closest_point_triangle(q, p3(0), p3(1), p3(2));
+            const double d = (b.x() * p3(0) + b.y() * p3(1) + b.z() * p3(2) - q).squaredNorm();
+            if (d < best) {
+              best = d;
+              bf = f;
+              bb = b;
+            }
+          }
+        }
+      if (bf >= 0 && found_ring < 0) found_ring = ring;
+      if (found_ring >= 0 && ring > found_ring) break;
+    }
+    if (bf < 0) throw std::runtime_error("sim/sim_metrics: source garment has no UV triangles");
+    Vec3 x = Vec3::Zero();
+    for (int k = 0; k < 3; ++k) x += bb(k) * from_X.row(from.F(bf, k)).transpose();
+    out.row(to.uv_to_vertex[u]) += x.transpose();
+    ++count[to.uv_to_vertex[u]];
+  }
+  for (int v = 0; v < out.rows(); ++v) out.row(v) /= std::max(1, count[v]);
+  return out;
+}
+
 std::vector<FrameMetrics> sequence_metrics(const gdsr::GarmentMesh& g, const std::vector<Points3>& frames,
                                            const gdsr::Faces& body_F, const std::vector<Points3>& body_frames,
                                            double fps, double density) {

@@ -37,6 +37,12 @@ struct WrinkleMeasure {
 };
 WrinkleMeasure wrinkle_measure(const gdsr::Points3& X, const gdsr::Faces& F);
 
+// Positions of `to`'s welded vertices sampled from `from_X` (positions of `from`) through
+// the shared UV layout: each UV vertex of `to` takes the barycentric point of the `from` UV
+// triangle containing it (nearest triangle, clamped, outside every triangle); seam copies
+// are averaged. Used to compare HR with the LR upsampled to HR topology (same pattern).
+gdsr::Points3 resample_by_uv(const gdsr::GarmentMesh& from, const gdsr::Points3& from_X, const gdsr::GarmentMesh& to);
+
 struct FrameMetrics {
   StrainEnergies strain;
   Penetration penetration;

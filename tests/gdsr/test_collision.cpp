@@ -1,5 +1,6 @@
 #include <doctest/doctest.h>
 
+#include "gdsr/body_query.hpp"
 #include "gdsr/collision.hpp"
 #include "loss_test_meshes.hpp"
 
@@ -145,4 +146,35 @@ TEST_CASE("collision: inconsistent inputs throw") {
   CHECK_THROWS(resolve_collisions({}, in, G));
   nearest = {0, 1, 5};
   CHECK_THROWS(resolve_collisions({}, in, G));
+}
+
+TEST_CASE("collision: the Embree body adapter pushes out of a real body mesh") {
+  // A closed box body [-0.5, 0.5]^3 (12 outward triangles); the LR vertex sits 5 mm outside
+  // the top face, its HR vertex 10 mm inside.
+  TriMesh box;
+  box.V.resize(8, 3);
+  for (int i = 0; i < 8; ++i) box.V.row(i) << (i & 1 ? 0.5 : -0.5), (i & 2 ? 0.5 : -0.5), (i & 4 ? 0.5 : -0.5);
+  box.F.resize(12, 3);
+  box.F << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5;
+  const BodyQuery q(box);
+  const BodyQueryFn fn = body_query_fn(q);
+  Points3 C(1, 3);
+  C << 0.1, 0.505, -0.05;
+  Points3 G(1, 3);
+  G << 0.12, 0.49, -0.04;
+  const std::vector<int> nearest = {0};
+  CollisionInput in;
+  in.C_hat = &C;
+  in.hr_nearest_lr = &nearest;
+  in.body = &fn;
+  const CollisionStats st = resolve_collisions({}, in, G);
+  CHECK(st.lr_body == 1);
+  CHECK(st.hr_body == 1);
+  // Moved along the LR vertex's (smooth) body normal to offset sigma_b from its body point.
+  const ClosestPoints c = q.closest(C);
+  const Vec3 n = c.normal.row(0).transpose(), b = c.point.row(0).transpose();
+  const Vec3 g = G.row(0).transpose(), g0(0.12, 0.49, -0.04);
+  CHECK((g - b).dot(n) == doctest::Approx(0.015));
+  CHECK((g - g0).cross(n).norm() < 1e-12);
+  CHECK(n.y() > 0.5);
 }

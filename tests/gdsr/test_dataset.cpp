@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <sstream>
 
 using namespace gdsr;
 using gdsr_test::TempDir;
@@ -238,6 +239,22 @@ TEST_CASE("dataset: Marvelous Designer import from per-frame OBJs") {
   write_dataset(dir / "out", d);
   CHECK(load_dataset(dir / "out").manifest.hr_vertices == hr.V.rows());
 
+  SUBCASE("unwelded 3-D exports are welded on request") {
+    // Unwelded: one 3-D vertex per UV vertex (seam copies coincide), faces = FUV.
+    for (int t = 0; t < T; ++t) {
+      Points3 X(hr.UV.rows(), 3);
+      for (int u = 0; u < hr.UV.rows(); ++u) X.row(u) = (hr.V.row(hr.uv_to_vertex[u]).array() + 0.01 * t) * 1000.0;
+      write_obj(dir / ("hr/skirt_" + std::to_string(t * 5) + ".obj"), TriMesh{X, hr.FUV});
+    }
+    CHECK(import_md(opt).hr.V.rows() == hr.UV.rows());  // not welded: the seam stays open
+    opt.weld = 1e-4;
+    const Dataset w = import_md(opt);
+    CHECK(w.hr.V.rows() == hr.V.rows());
+    CHECK(unique_edges(w.hr.F).rows() == unique_edges(hr.F).rows());
+    CHECK((upsample(w.corr, w.lr_frames[2]) - w.hr_frames[2]).cwiseAbs().maxCoeff() < 1e-8);
+    opt.weld = 0.2;  // absurd: collapses triangles
+    CHECK_THROWS_WITH_AS(import_md(opt), doctest::Contains("collapses"), std::runtime_error);
+  }
   SUBCASE("mismatched frame counts") {
     fs::remove(dir / "hr/skirt_15.obj");
     CHECK_THROWS_WITH_AS(import_md(opt), doctest::Contains("mismatched frame counts"), std::runtime_error);
@@ -256,4 +273,20 @@ TEST_CASE("dataset: Marvelous Designer import from per-frame OBJs") {
     write_text(dir / "hr/skirt_5.obj", "v nan 0 0\n");
     CHECK_THROWS_WITH_AS(import_md(opt), doctest::Contains("skirt_5.obj:1"), std::runtime_error);
   }
+}
+
+TEST_CASE("dataset: progress bar draws in 10% steps off a terminal") {
+  std::ostringstream os;
+  {
+    ProgressBar bar("work", &os, 10);
+    auto cb = bar.callback();
+    for (int i = 1; i <= 50; ++i) cb(i, 50);
+    bar.finish();
+  }
+  const std::string s = os.str();
+  int lines = 0;
+  for (char c : s) lines += c == '\n';
+  CHECK(lines == 11);  // the first update (0%), then 10%, 20%, ..., 100%
+  CHECK(s.find("work [##########] 100% 50/50") != std::string::npos);
+  CHECK(s.find("work [#.........]  10% 5/50") != std::string::npos);
 }

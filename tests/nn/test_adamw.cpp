@@ -79,7 +79,7 @@ TEST_CASE("AdamW: reproduces the hand-computed update sequence (Adam and AMSGrad
   // The two variants really differ on this sequence (so the amsgrad branch is exercised).
   const auto a = reference({0.8, -1.5, 2.0}, steps, 0.05, 0.9, 0.999, 1e-8, 0.1, false);
   const auto b = reference({0.8, -1.5, 2.0}, steps, 0.05, 0.9, 0.999, 1e-8, 0.1, true);
-  CHECK(max_err(a, b) > 1e-3);
+  CHECK(max_err(a, b) > 1e-5);  // 1.2e-4 here, far above the 1e-13 agreement checked above
 }
 
 TEST_CASE("AdamW: first step moves by lr * sign(g) after decoupled decay") {
@@ -140,5 +140,6 @@ TEST_CASE("schedules: step decay halves every N steps down to the floor; loss-we
   CHECK(w100.coarse == 1.0);
   CHECK(w100.fine == 1.0);
   CHECK(nn::gdsr_loss_weights(0, false).coarse == 1.0);
-  CHECK_THROWS_AS(nn::StepDecay{1e-4, 0.5, 0, 0}(5), ag::Error);
+  const nn::StepDecay bad{1e-4, 0.5, 0, 0};
+  CHECK_THROWS_AS(bad(5), ag::Error);
 }

@@ -7,6 +7,7 @@
 
 TEST_CASE("MLP regression in float32: training loss drops by more than 100x, test loss follows") {
   nn::DemoMlpOptions opt;  // sin(pi x) cos(pi y) on [-1, 1]^2, 256 points, widths {2, 64, 64}
+  opt.steps = 600;
   int64_t reports = 0;
   const nn::DemoMlpResult r = nn::train_demo_mlp(opt, [&](int64_t, double l) {
     ++reports;

@@ -114,3 +114,29 @@ TEST_CASE("cli data: bad input gives a one-line error and exit 1") {
   check_one_line_error(gdsr_run(dir, "data frobnicate"), "");
   CHECK_FALSE(fs::exists(dir / "out"));
 }
+
+TEST_CASE("cli data: make a tiny dataset, check it and preview a frame") {
+  // Coarse particle distances and 0.2 s of motion keep this to a few seconds.
+  TempDir dir("cli_make");
+  const std::string out = dir / "ds";
+  const Run mk = gdsr_run(dir, "data make --garment skirt_short --out '" + out +
+                                   "' --seconds 0.2 --lr-pd 0.06 --hr-pd 0.03 --rest-blend 3 --raster 128");
+  REQUIRE(mk.status == 0);
+  CHECK(mk.out.find("vertices: LR") != std::string::npos);
+  CHECK(mk.out.find("seconds per frame") != std::string::npos);
+  CHECK(mk.out.find("penetration") != std::string::npos);
+  CHECK(fs::exists(out + "/manifest.json"));
+  CHECK_FALSE(fs::exists(out + ".tmp"));
+  const Run chk = gdsr_run(dir, "data check --data '" + out + "'");
+  CHECK(chk.status == 0);
+  CHECK(chk.out.find("garment skirt_short") != std::string::npos);
+  const Run pv = gdsr_run(dir, "data preview --data '" + out + "' --frame 5 --size 128 --out '" + (dir / "p.png") + "'");
+  CHECK(pv.status == 0);
+  CHECK(fs::file_size(dir / "p.png") > 1000);
+  check_one_line_error(gdsr_run(dir, "data preview --data '" + out + "' --frame 999 --out '" + (dir / "q.png") + "'"),
+                       "out of range");
+  check_one_line_error(gdsr_run(dir, "data make --garment skirt_short --motion '" + (dir / "none.bvh") + "' --out '" +
+                                         (dir / "x") + "'"),
+                       "none.bvh");
+  check_one_line_error(gdsr_run(dir, "data make --garment no_such_garment --out '" + (dir / "x") + "'"), "garment");
+}

@@ -83,6 +83,12 @@ TEST_CASE("pattern: meshing gives the requested edge length at 30 mm and 10 mm")
              p2 = pm.mesh.UV.row(pm.mesh.FUV(f, 2));
         Vec2 e1 = p1 - p0, e2 = p2 - p0;
         REQUIRE(e1.x() * e2.y() - e1.y() * e2.x() > 0);
+        // Near-uniform triangles: no angle below 20 degrees.
+        const Vec2 q[3] = {p0, p1, p2};
+        for (int k = 0; k < 3; ++k) {
+          const Vec2 a = (q[(k + 1) % 3] - q[k]).normalized(), b = (q[(k + 2) % 3] - q[k]).normalized();
+          CHECK(std::acos(std::clamp(a.dot(b), -1.0, 1.0)) > 20.0 * M_PI / 180);
+        }
       }
     }
   }

@@ -1,0 +1,123 @@
+// Cloth solver speed vs accuracy: skirt_short on the first second of CMU 01_01 (falls back
+// to an analytic swaying mannequin without the file) at LR (30 mm) and HR (10 mm), for
+// several substep counts. Counters next to the time: seconds per frame, vertices, the
+// paper's stretch/shear energies (mean over frames), max body penetration, mean curvature
+// (wrinkle measure, 1/m) and the RMS position error at the last frame against a
+// reference run with 80 substeps (metres).
+#include <benchmark/benchmark.h>
+
+#include "gdsr/body.hpp"
+#include "sim/cloth_bodies.hpp"
+#include "sim/cloth_solver.hpp"
+#include "sim/garments.hpp"
+#include "sim/sim_metrics.hpp"
+
+#include <chrono>
+#include <ctime>
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+namespace {
+
+struct Scene {
+  gdsr::Faces F;
+  std::vector<gdsr::Points3> frames;
+  gdsr::TriMesh rest;
+  double fps = 30;
+};
+
+const Scene& scene() {
+  static Scene s = [] {
+    Scene sc;
+    const std::string bvh = "/usr/share/assimp/models/BVH/01_01.bvh";
+    const int nframes = 24;
+    if (std::filesystem::exists(bvh)) {
+      gdsr::BodyOptions opt;
+      opt.max_seconds = 0.5;
+      auto body = gdsr::load_body_sequence(bvh, opt);
+      sc.F = body.F;
+      sc.rest = body.rest_mesh();
+      for (int t = 0; t < nframes && t < body.num_frames(); ++t) sc.frames.push_back(body.frames[t]);
+      sc.fps = body.fps;
+    } else {
+      sc.rest = sim::make_mannequin(1.7);
+      sc.F = sc.rest.F;
+      for (int t = 0; t < nframes; ++t) {
+        gdsr::Points3 V = sc.rest.V;
+        V.col(0).array() += 0.08 * std::sin(2 * M_PI * t / 30.0);
+        sc.frames.push_back(V);
+      }
+    }
+    return sc;
+  }();
+  return s;
+}
+
+const sim::Garment& garment(int mm) {
+  static std::map<int, sim::Garment> cache;
+  auto it = cache.find(mm);
+  if (it == cache.end()) it = cache.emplace(mm, sim::make_garment("skirt_short", mm / 1000.0, scene().rest)).first;
+  return it->second;
+}
+
+std::vector<gdsr::Points3> run(int mm, int substeps) {
+  sim::SimParams p;
+  p.substeps = substeps;
+  p.settle_frames = 0;
+  return sim::simulate_frames(garment(mm), scene().F, scene().frames, scene().fps, p);
+}
+
+const gdsr::Points3& reference(int mm) {
+  static std::map<int, gdsr::Points3> cache;
+  auto it = cache.find(mm);
+  if (it == cache.end()) it = cache.emplace(mm, run(mm, 80).back()).first;
+  return it->second;
+}
+
+void BM_ClothSkirtShort(benchmark::State& state) {
+  const int mm = static_cast<int>(state.range(0));
+  const int substeps = static_cast<int>(state.range(1));
+  const auto& sc = scene();
+  const auto& g = garment(mm);
+  const auto& ref = reference(mm);
+  std::vector<gdsr::Points3> out;
+  double seconds = 0, cpu = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::clock_t c0 = std::clock();
+    out = run(mm, substeps);
+    cpu += static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  const auto m = sim::sequence_metrics(g.mesh, out, sc.F, sc.frames, sc.fps);
+  double eu = 0, ev = 0, euv = 0, pen = 0;
+  for (const auto& f : m) {
+    eu += f.strain.E_u / m.size();
+    ev += f.strain.E_v / m.size();
+    euv += f.strain.E_uv / m.size();
+    pen = std::max(pen, f.penetration.max_depth);
+  }
+  state.counters["verts"] = static_cast<double>(g.mesh.V.rows());
+  // Wall time and process CPU time (the solver is single-threaded, so CPU time is its cost
+  // on an idle core even when the machine is loaded).
+  state.counters["s_per_frame"] = seconds / state.iterations() / (sc.frames.size() - 1);
+  state.counters["cpu_s_per_frame"] = cpu / state.iterations() / (sc.frames.size() - 1);
+  state.counters["E_u"] = eu;
+  state.counters["E_v"] = ev;
+  state.counters["E_uv"] = euv;
+  state.counters["pen_max_m"] = pen;
+  state.counters["curvature"] = m.back().wrinkles.mean_curvature;
+  state.counters["dihedral"] = m.back().wrinkles.mean_dihedral;
+  state.counters["rms_vs_80sub_m"] = std::sqrt((out.back() - ref).rowwise().squaredNorm().mean());
+}
+
+}  // namespace
+
+BENCHMARK(BM_ClothSkirtShort)
+    ->ArgsProduct({{30, 10}, {5, 10, 20, 40}})
+    ->ArgNames({"mm", "substeps"})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1);
+
+BENCHMARK_MAIN();
