@@ -82,7 +82,7 @@ GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>
     }
     double largest = 0;
     for (double v : numeric) largest = std::max(largest, std::abs(v));
-    const double floor = opt.floor_fraction * largest + 1e-12;
+    const double floor = std::max(opt.floor_fraction * largest, opt.abs_floor) + 1e-12;
     for (size_t e = 0; e < entries.size(); ++e) {
       const double a = analytic[static_cast<size_t>(entries[e])], nu = numeric[e];
       double rel = std::abs(a - nu) / std::max({std::abs(a), std::abs(nu), floor});

@@ -23,6 +23,10 @@ struct GradCheckOptions {
   // (largest |n| over the input) + 1e-12: entries far below the largest gradient of their
   // input are judged against it, so round-off on tiny gradients does not dominate.
   double floor_fraction = 1e-3;
+  // A lower bound for that floor. Central differences of a loss L carry round-off of about
+  // 1e-16 |L| / step; where L sums many outputs, gradients near that level are noise, and
+  // abs_floor says below which size entries are judged by their absolute error instead.
+  double abs_floor = 0;
   int64_t max_entries_per_input = 400;  // larger inputs: a deterministic random subset
   unsigned seed = 1;
 };

@@ -70,12 +70,22 @@ TEST_CASE("model gradcheck: whole GDSR model, tiny preset, float64") {
   const size_t num_params = inputs.size();
   ag::GradCheckOptions opt;
   opt.max_entries_per_input = 60;
+  // Entries below 1e-3 are judged by absolute error: the loss sums 117 outputs, and its
+  // central differences carry round-off near 1e-8 (seen: analytic -1.8e-13 vs numeric
+  // -8.1e-9 on a parameter whose other gradients are ~1e-1).
+  opt.abs_floor = 1e-3;
   const ag::GradCheckResult r = ag::gradcheck([&](const std::vector<ag::Tensord>&) { return f({C}); }, inputs, opt);
   MESSAGE("parameters: " << model.num_parameters() << " in " << num_params << " tensors; checked "
                          << r.checked << " entries; " << r.report());
   CHECK(r.max_rel_error < 1e-5);
   CHECK(r.checked > 500);
-  const ag::GradCheckResult rc = ag::gradcheck(f, {C}, opt);
+  // With respect to C the step must be 1e-7 (tolerance unchanged): the worst relative error
+  // falls 1.25 -> 0.22 -> 8e-3 -> 2e-7 for steps 1e-4 -> 1e-5 -> 1e-6 -> 1e-7 (and is 2e-6
+  // at 1e-8, round-off): truncation error of the strongly curved normalised features of a
+  // 10 cm garment (channel norm over 18 vertices), not a wrong gradient.
+  ag::GradCheckOptions opt_c = opt;
+  opt_c.step = 1e-7;
+  const ag::GradCheckResult rc = ag::gradcheck(f, {C}, opt_c);
   MESSAGE("input positions C: " << rc.report());
   CHECK(rc.max_rel_error < 1e-5);
 }
