@@ -1,5 +1,7 @@
 #include "gdsr/dataset.hpp"
 
+#include "nn/checkpoint.hpp"
+
 #include "gdsr/obj_io.hpp"
 
 #include <cmath>
@@ -155,12 +157,7 @@ uint64_t Array::count() const {
 }
 
 uint64_t fnv1a64(const char* data, size_t n) {
-  uint64_t h = 1469598103934665603ull;
-  for (size_t i = 0; i < n; ++i) {
-    h ^= static_cast<unsigned char>(data[i]);
-    h *= 1099511628211ull;
-  }
-  return h;
+  return nn::fnv1a64(reinterpret_cast<const uint8_t*>(data), n);  // the checkpoints' checksum
 }
 
 void write_array(const std::string& path, const Array& a) {

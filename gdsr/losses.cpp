@@ -1,5 +1,7 @@
 #include "gdsr/losses.hpp"
 
+#include "nn/lr_schedule.hpp"
+
 #include "autograd/ops_elementwise.hpp"
 #include "autograd/ops_index.hpp"
 #include "autograd/ops_loss.hpp"
@@ -132,14 +134,13 @@ Lambdas lambda_schedule(const LossConfig& c, int epoch) {
     l.fine = c.lambda_w_end;
     return l;
   }
-  const double steps = std::floor(std::max(0, epoch) / static_cast<double>(c.lambda_every_epochs));
-  const double move = steps * c.lambda_step;
-  // Each lambda moves toward its end value and stops there.
-  auto toward = [&](double start, double end) {
-    return start > end ? std::max(end, start - move) : std::min(end, start + move);
+  const int64_t e = std::max(0, epoch);
+  const int64_t every = c.lambda_every_epochs;
+  auto ramp = [&](double start, double end) {  // moves toward its end value and stops there
+    return nn::RampSchedule{start, start > end ? -c.lambda_step : c.lambda_step, every, end}(e);
   };
-  l.coarse = toward(c.lambda_c_start, c.lambda_c_end);
-  l.fine = toward(c.lambda_w_start, c.lambda_w_end);
+  l.coarse = ramp(c.lambda_c_start, c.lambda_c_end);
+  l.fine = ramp(c.lambda_w_start, c.lambda_w_end);
   return l;
 }
 

@@ -23,10 +23,4 @@ double RampSchedule::operator()(int64_t epoch) const {
   return v;
 }
 
-LossWeights gdsr_loss_weights(int64_t epoch, bool enabled) {
-  if (!enabled) return {1.0, 1.0};
-  const RampSchedule c{1.9, -0.2, 10, 1.0}, w{0.1, 0.2, 10, 1.0};
-  return {c(epoch), w(epoch)};
-}
-
 }  // namespace nn

@@ -28,12 +28,6 @@ struct RampSchedule {
   double target = 1.0;
   double operator()(int64_t epoch) const;
 };
-
-struct LossWeights {
-  double coarse, fine;  // lambda_c, lambda_w
-};
-// The paper's schedule for (lambda_c, lambda_w); enabled = false gives (1, 1) as the
-// released script does.
-LossWeights gdsr_loss_weights(int64_t epoch, bool enabled);
+// (gdsr::lambda_schedule in gdsr/losses.hpp builds the two GDSR ramps from the loss config.)
 
 }  // namespace nn

@@ -132,14 +132,13 @@ TEST_CASE("schedules: step decay halves every N steps down to the floor; loss-we
   sd.apply(opt, 300);
   CHECK(opt.lr() == doctest::Approx(1.25e-5));
 
-  auto w0 = nn::gdsr_loss_weights(0, true), w15 = nn::gdsr_loss_weights(15, true), w100 = nn::gdsr_loss_weights(100, true);
-  CHECK(w0.coarse == doctest::Approx(1.9));
-  CHECK(w0.fine == doctest::Approx(0.1));
-  CHECK(w15.coarse == doctest::Approx(1.7));
-  CHECK(w15.fine == doctest::Approx(0.3));
-  CHECK(w100.coarse == 1.0);
-  CHECK(w100.fine == 1.0);
-  CHECK(nn::gdsr_loss_weights(0, false).coarse == 1.0);
+  const nn::RampSchedule down{1.9, -0.2, 10, 1.0}, up{0.1, 0.2, 10, 1.0};  // the paper's lambda_c, lambda_w
+  CHECK(down(0) == doctest::Approx(1.9));
+  CHECK(up(0) == doctest::Approx(0.1));
+  CHECK(down(15) == doctest::Approx(1.7));
+  CHECK(up(15) == doctest::Approx(0.3));
+  CHECK(down(100) == 1.0);
+  CHECK(up(100) == 1.0);
   const nn::StepDecay bad{1e-4, 0.5, 0, 0};
   CHECK_THROWS_AS(bad(5), ag::Error);
 }
