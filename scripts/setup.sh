@@ -22,6 +22,17 @@ fi
 jobs=$(nproc 2>/dev/null || echo 2)
 if [ ! -f build/CMakeCache.txt ]; then
   cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+  echo "setup: first build in build/ (about 10 minutes on 2 cores)"
 fi
-cmake --build build -j"$jobs" 2>&1 | grep -E 'error|warning: unused|Error' || true
-cmake --build build -j"$jobs" >/dev/null   # fails loudly if the first pass failed
+# Progress: the percentages make prints, on one line; the whole log is in build/build.log.
+set +o pipefail
+cmake --build build -j"$jobs" 2>&1 | tee build/build.log |
+  grep --line-buffered -oE '^\[ *[0-9]+%\]' | uniq |
+  awk '{ printf "%s ", $0; fflush() } END { if (NR) print "" }' >&2
+status=${PIPESTATUS[0]}
+set -o pipefail
+if [ "$status" -ne 0 ]; then
+  grep -E 'error|Error' build/build.log | head -30 >&2
+  echo "setup: build failed (full log: build/build.log)" >&2
+  exit 1
+fi
