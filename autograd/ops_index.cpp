@@ -50,16 +50,20 @@ template <class T> Tensor<T> index_select_rows(const Tensor<T>& x, const Index& 
   return out;
 }
 
+// Shared checks of the scatter ops: x 2-D, one index per row, indices in [0, num_rows).
+static void check_scatter(const char* op, const Shape& xs, const Index& index, int64_t num_rows) {
+  check_2d(op, xs);
+  if (static_cast<int64_t>(index.size()) != xs[0])
+    throw Error(std::string(op) + ": " + std::to_string(index.size()) + " indices for " + shape_str(xs));
+  if (num_rows < 0) throw Error(std::string(op) + ": negative num_rows");
+  check_index(op, index, num_rows, xs);
+}
+
 // ---- scatter_add_rows (segment sum) -----------------------------------------------------------
 template <class T>
 Tensor<T> scatter_add_rows(const Tensor<T>& x, const Index& index, int64_t num_rows) {
-  check_2d("scatter_add_rows", x.shape());
+  check_scatter("scatter_add_rows", x.shape(), index, num_rows);
   const int64_t N = x.rows(), C = x.cols();
-  if (static_cast<int64_t>(index.size()) != N)
-    throw Error("scatter_add_rows: " + std::to_string(index.size()) + " indices for " +
-                shape_str(x.shape()));
-  if (num_rows < 0) throw Error("scatter_add_rows: negative num_rows");
-  check_index("scatter_add_rows", index, num_rows, x.shape());
   auto out = new_output<T>({num_rows, C});
   scatter_add_serial(out.data(), x.data(), index, C);
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), index, C, N] {
@@ -79,13 +83,8 @@ Tensor<T> scatter_add_rows(const Tensor<T>& x, const Index& index, int64_t num_r
 // ---- scatter_mean_rows --------------------------------------------------------------------------
 template <class T>
 Tensor<T> scatter_mean_rows(const Tensor<T>& x, const Index& index, int64_t num_rows) {
-  check_2d("scatter_mean_rows", x.shape());
+  check_scatter("scatter_mean_rows", x.shape(), index, num_rows);
   const int64_t N = x.rows(), C = x.cols();
-  if (static_cast<int64_t>(index.size()) != N)
-    throw Error("scatter_mean_rows: " + std::to_string(index.size()) + " indices for " +
-                shape_str(x.shape()));
-  if (num_rows < 0) throw Error("scatter_mean_rows: negative num_rows");
-  check_index("scatter_mean_rows", index, num_rows, x.shape());
   std::vector<real_t<T>> inv(static_cast<size_t>(num_rows), 0);
   for (int64_t i : index) inv[i] += 1;
   for (auto& v : inv) v = v > 0 ? real_t<T>(1) / v : real_t<T>(0);
