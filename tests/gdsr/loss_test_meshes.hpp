@@ -4,6 +4,7 @@
 #include "gdsr/mesh.hpp"
 
 #include <cmath>
+#include <vector>
 
 namespace gdsr_test {
 
@@ -44,6 +45,23 @@ inline gdsr::Points3 bumpy(const gdsr::Points3& V, double a, double scale, int s
     X(r, 1) += 0.05 * L * std::cos(5.3 * r + 2 * seed) / std::sqrt(static_cast<double>(V.rows()));
   }
   return X * scale;
+}
+
+// A grid garment cut to the triangle x + y < 0.75 L (so the raster has a diagonal edge and a
+// large empty region). Unused grid vertices stay (isolated).
+inline gdsr::GarmentMesh cut_garment(int n, double h) {
+  gdsr::GarmentMesh g = gdsr_test::grid_garment(n, h);
+  const double L = (n - 1) * h;
+  std::vector<int> keep;
+  for (int f = 0; f < g.F.rows(); ++f) {
+    const gdsr::Vec3 c = (g.V.row(g.F(f, 0)) + g.V.row(g.F(f, 1)) + g.V.row(g.F(f, 2))).transpose() / 3.0;
+    if (c.x() + c.y() < 0.75 * L) keep.push_back(f);
+  }
+  gdsr::Faces F(static_cast<int>(keep.size()), 3);
+  for (size_t i = 0; i < keep.size(); ++i) F.row(static_cast<int>(i)) = g.F.row(keep[i]);
+  g.F = F;
+  g.FUV = F;
+  return g;
 }
 
 }  // namespace gdsr_test

@@ -36,21 +36,6 @@ LossConfig only(const std::string& term) {
   return c;
 }
 
-// Same grid cut as the patch tests (garment and background pixels in a raster).
-GarmentMesh cut_grid(int n, double h) {
-  GarmentMesh g = gdsr_test::grid_garment(n, h);
-  const double L = (n - 1) * h;
-  std::vector<int> keep;
-  for (int f = 0; f < g.F.rows(); ++f) {
-    const Vec3 c = (g.V.row(g.F(f, 0)) + g.V.row(g.F(f, 1)) + g.V.row(g.F(f, 2))).transpose() / 3.0;
-    if (c.x() + c.y() < 0.75 * L) keep.push_back(f);
-  }
-  Faces F(static_cast<int>(keep.size()), 3);
-  for (size_t i = 0; i < keep.size(); ++i) F.row(static_cast<int>(i)) = g.F.row(keep[i]);
-  g.F = F;
-  g.FUV = F;
-  return g;
-}
 
 ag::Tensord rows_of(const Points3& P, const std::vector<int>& rows) {
   Points3 R(static_cast<int>(rows.size()), 3);
@@ -182,7 +167,7 @@ TEST_CASE("losses: coarse loss is finite with zero-area triangles") {
 }
 
 TEST_CASE("losses: fine loss over a patch batch, with an image-loss callback, float64 gradient check") {
-  const GarmentMesh g = cut_grid(21, 0.01);
+  const GarmentMesh g = gdsr_test::cut_garment(21, 0.01);
   PatchConfig pc;
   pc.size = 24;
   pc.count = 3;

@@ -12,22 +12,6 @@ using namespace gdsr;
 
 namespace {
 
-// A grid garment cut to the triangle x + y < 0.75 L (so the raster has a diagonal edge and a
-// large empty region). Unused grid vertices stay (isolated).
-GarmentMesh cut_garment(int n, double h) {
-  GarmentMesh g = gdsr_test::grid_garment(n, h);
-  const double L = (n - 1) * h;
-  std::vector<int> keep;
-  for (int f = 0; f < g.F.rows(); ++f) {
-    const Vec3 c = (g.V.row(g.F(f, 0)) + g.V.row(g.F(f, 1)) + g.V.row(g.F(f, 2))).transpose() / 3.0;
-    if (c.x() + c.y() < 0.75 * L) keep.push_back(f);
-  }
-  Faces F(static_cast<int>(keep.size()), 3);
-  for (size_t i = 0; i < keep.size(); ++i) F.row(static_cast<int>(i)) = g.F.row(keep[i]);
-  g.F = F;
-  g.FUV = F;
-  return g;
-}
 
 std::vector<int> fake_lr_map(int nv) {
   std::vector<int> m(nv);
@@ -43,7 +27,7 @@ PatchSampler make_sampler(const GarmentMesh& g, int raster_size, PatchConfig cfg
 }  // namespace
 
 TEST_CASE("patches: sampled windows stay inside the 1024 raster and cover garment pixels") {
-  const GarmentMesh g = cut_garment(41, 0.01);
+  const GarmentMesh g = gdsr_test::cut_garment(41, 0.01);
   for (bool random : {true, false}) {
     CAPTURE(random);
     PatchConfig cfg;  // 80 x 80, 8 patches, coverage >= 0.1
@@ -68,7 +52,7 @@ TEST_CASE("patches: sampled windows stay inside the 1024 raster and cover garmen
 }
 
 TEST_CASE("patches: a patch lists exactly the HR vertices under its pixels, its halo and LR triangles") {
-  const GarmentMesh g = cut_garment(41, 0.01);
+  const GarmentMesh g = gdsr_test::cut_garment(41, 0.01);
   PatchConfig cfg;
   cfg.size = 40;
   const PatchSampler s = make_sampler(g, 256, cfg);
@@ -108,7 +92,7 @@ TEST_CASE("patches: a patch lists exactly the HR vertices under its pixels, its 
 }
 
 TEST_CASE("patches: inside-vertex normals of a patch equal the whole mesh's (halo)") {
-  const GarmentMesh g = cut_garment(31, 0.01);
+  const GarmentMesh g = gdsr_test::cut_garment(31, 0.01);
   PatchConfig cfg;
   cfg.size = 40;
   const PatchSampler s = make_sampler(g, 256, cfg);
@@ -125,7 +109,7 @@ TEST_CASE("patches: inside-vertex normals of a patch equal the whole mesh's (hal
 }
 
 TEST_CASE("patches: the normal map of a flat patch is uniform (0.5, 0.5, 1) on the garment") {
-  const GarmentMesh g = cut_garment(41, 0.01);
+  const GarmentMesh g = gdsr_test::cut_garment(41, 0.01);
   PatchConfig cfg;  // 80 x 80 of 1024
   const PatchSampler s = make_sampler(g, 1024, cfg);
   // A window across the diagonal edge of the cut: garment and background pixels.
@@ -157,7 +141,7 @@ TEST_CASE("patches: the normal map of a flat patch is uniform (0.5, 0.5, 1) on t
 }
 
 TEST_CASE("patches: float64 gradient check of the normal map w.r.t. the patch's positions") {
-  const GarmentMesh g = cut_garment(21, 0.01);
+  const GarmentMesh g = gdsr_test::cut_garment(21, 0.01);
   PatchConfig cfg;
   cfg.size = 24;
   const PatchSampler s = make_sampler(g, 128, cfg);
