@@ -19,8 +19,8 @@ std::string GradCheckResult::report() const {
   return o.str();
 }
 
-GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>&)>& f,
-                          std::vector<Tensord> inputs, const GradCheckOptions& opt) {
+GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>&)>& f, std::vector<Tensord> inputs,
+                          const GradCheckOptions& opt) {
   std::mt19937_64 rng(opt.seed);
   for (auto& x : inputs) {
     if (x.node().backward_fn) throw Error("gradcheck: inputs must be leaves");
@@ -65,8 +65,7 @@ GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>
       std::shuffle(entries.begin(), entries.end(), rng);
       entries.resize(static_cast<size_t>(opt.max_entries_per_input));
     }
-    const std::vector<double> analytic =
-        x.has_grad() ? x.grad() : std::vector<double>(static_cast<size_t>(n), 0.0);
+    const std::vector<double> analytic = x.has_grad() ? x.grad() : std::vector<double>(static_cast<size_t>(n), 0.0);
 
     std::vector<double> numeric(entries.size());
     for (size_t e = 0; e < entries.size(); ++e) {

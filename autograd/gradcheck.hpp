@@ -9,16 +9,16 @@
 namespace ag {
 
 struct GradCheckResult {
-  double max_rel_error = 0;  // worst relative error over all checked entries
-  int input = -1;            // which input holds the worst entry
-  int64_t element = -1;      // flat index of the worst entry in that input
+  double max_rel_error = 0;          // worst relative error over all checked entries
+  int input = -1;                    // which input holds the worst entry
+  int64_t element = -1;              // flat index of the worst entry in that input
   double analytic = 0, numeric = 0;  // the two values there
-  int64_t checked = 0;       // number of entries compared
+  int64_t checked = 0;               // number of entries compared
   std::string report() const;
 };
 
 struct GradCheckOptions {
-  double step = 1e-6;          // relative step: h = step * max(1, |x|)
+  double step = 1e-6;  // relative step: h = step * max(1, |x|)
   // Entries are compared as |a - n| / max(|a|, |n|, floor), floor = floor_fraction *
   // (largest |n| over the input) + 1e-12: entries far below the largest gradient of their
   // input are judged against it, so round-off on tiny gradients does not dominate.
@@ -34,7 +34,7 @@ struct GradCheckOptions {
 // f maps the inputs to a tensor; the check differentiates L = sum(w * f(inputs)) with fixed
 // random weights w. Analytic gradients come from backward(); numeric ones from central
 // differences of L. Inputs must be leaves; they are restored afterwards.
-GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>&)>& f,
-                          std::vector<Tensord> inputs, const GradCheckOptions& opt = {});
+GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>&)>& f, std::vector<Tensord> inputs,
+                          const GradCheckOptions& opt = {});
 
 }  // namespace ag

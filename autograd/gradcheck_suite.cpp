@@ -44,11 +44,19 @@ std::vector<Case> cases() {
   c.push_back({"linear", [](V x) { return linear(x[0], x[1], x[2]); }, {{4, 3}, {5, 3}, {1, 5}}});
   c.push_back({"transpose", [](V x) { return transpose(x[0]); }, {{4, 3}}});
   c.push_back({"sum_rows / mean_cols", [](V x) { return add(sum_rows(x[0]), mean(mean_cols(x[0]))); }, {{4, 3}}});
-  c.push_back({"concat / slice", [](V x) { return slice_cols(concat_cols<double>({x[0], x[1]}), 1, 4); }, {{4, 3}, {4, 2}}});
+  c.push_back({"concat / slice",
+               [](V x) {
+                 return slice_cols(concat_cols<double>({x[0], x[1]}), 1, 4);
+               },
+               {{4, 3}, {4, 2}}});
   c.push_back({"index_select_rows", [](V x) { return index_select_rows(x[0], {3, 0, 0, 2}); }, {{4, 3}}});
   c.push_back({"scatter_add_rows", [](V x) { return scatter_add_rows(x[0], {1, 0, 1, 3}, 5); }, {{4, 3}}});
   c.push_back({"scatter_mean_rows", [](V x) { return scatter_mean_rows(x[0], {1, 0, 1, 3}, 5); }, {{4, 3}}});
-  c.push_back({"interpolate_rows", [](V x) { return interpolate_rows(x[0], {0, 1, 2, 3, 2, 1}, x[1]); }, {{4, 3}, {2, 3}}});
+  c.push_back({"interpolate_rows",
+               [](V x) {
+                 return interpolate_rows(x[0], {0, 1, 2, 3, 2, 1}, x[1]);
+               },
+               {{4, 3}, {2, 3}}});
   c.push_back({"dot_rows", [](V x) { return dot_rows(x[0], x[1]); }, {{4, 3}, {4, 3}}});
   c.push_back({"cross3", [](V x) { return cross3(x[0], x[1]); }, {{4, 3}, {4, 3}}});
   c.push_back({"norm_rows", [](V x) { return norm_rows(x[0]); }, {{4, 3}}});
@@ -57,7 +65,10 @@ std::vector<Case> cases() {
   c.push_back({"layer_norm", [](V x) { return layer_norm(x[0], 1e-5); }, {{4, 5}}});
   c.push_back({"l1_loss", [](V x) { return l1_loss(x[0], x[1]); }, {{4, 3}, {4, 3}}});
   c.push_back({"mse_loss", [](V x) { return mse_loss(x[0], x[1]); }, {{4, 3}, {4, 3}}});
-  c.push_back({"grouped_linear", [](V x) { return grouped_linear(x[0], x[1], x[2], {1, 0, 1, 1, 0}, 2); },
+  c.push_back({"grouped_linear",
+               [](V x) {
+                 return grouped_linear(x[0], x[1], x[2], {1, 0, 1, 1, 0}, 2);
+               },
                {{5, 3}, {2, 6}, {2, 2}}});
   c.push_back({"complex linear (complex_from, real, imag)",
                [](V x) { return split(linear(complex_from(x[0], x[1]), complex_from(x[2], x[3]), Tensorcd())); },
@@ -71,7 +82,8 @@ std::vector<Case> cases() {
                                              complex_from(x[4], x[5]), {0, 1, 1, 0}, 2));
                },
                {{4, 3}, {4, 3}, {2, 6}, {2, 6}, {2, 2}, {2, 2}}});
-  c.push_back({"wire", [](V x) { return split(wire(complex_from(x[0], x[1]), 5.0, 10.0)); }, {{4, 3}, {4, 3}}, -0.15, 0.15});
+  c.push_back(
+      {"wire", [](V x) { return split(wire(complex_from(x[0], x[1]), 5.0, 10.0)); }, {{4, 3}, {4, 3}}, -0.15, 0.15});
   c.push_back({"conv2d_3x3", [](V x) { return conv2d_3x3(x[0], x[1], x[2]); }, {{1, 2, 5, 4}, {3, 2, 3, 3}, {1, 3}}});
   c.push_back({"avg_pool2x2", [](V x) { return avg_pool2x2(x[0]); }, {{1, 2, 4, 6}}});
   c.push_back({"max_pool2x2", [](V x) { return max_pool2x2(x[0]); }, {{1, 2, 4, 6}}});

@@ -1,5 +1,5 @@
 // A summary gradient check over every op of the library on random float64 inputs: what
-// `gdsr demo` and `gdsr gradcheck` print. (The per-op tests in tests/autograd/ go further:
+// `gdsr demo` prints. (The per-op tests in tests/autograd/ go further:
 // extremes, broadcasting variants, errors.)
 #pragma once
 
@@ -19,7 +19,6 @@ struct NamedGradCheck {
 };
 
 // Runs all checks; `progress(done, total)` after each one (may be empty).
-std::vector<NamedGradCheck> run_gradcheck_suite(unsigned seed = 7,
-                                                const std::function<void(int, int)>& progress = {});
+std::vector<NamedGradCheck> run_gradcheck_suite(unsigned seed = 7, const std::function<void(int, int)>& progress = {});
 
 }  // namespace ag

@@ -13,18 +13,17 @@ template <class R> Tensor<std::complex<R>> complex_from(const Tensor<R>& re, con
   C* o = out.data();
 #pragma omp parallel for if (n > kParallelMin)
   for (int64_t i = 0; i < n; ++i) o[i] = C(a[i], b[i]);
-  record(out.node(), {re.node_ptr(), im.node_ptr()},
-         [an = &re.node(), bn = &im.node(), on = &out.node(), n] {
-           const C* g = on->grad.data();
-           if (an->requires_grad) {
-             an->ensure_grad();
-             for (int64_t i = 0; i < n; ++i) an->grad[i] += g[i].real();
-           }
-           if (bn->requires_grad) {
-             bn->ensure_grad();
-             for (int64_t i = 0; i < n; ++i) bn->grad[i] += g[i].imag();
-           }
-         });
+  record(out.node(), {re.node_ptr(), im.node_ptr()}, [an = &re.node(), bn = &im.node(), on = &out.node(), n] {
+    const C* g = on->grad.data();
+    if (an->requires_grad) {
+      an->ensure_grad();
+      for (int64_t i = 0; i < n; ++i) an->grad[i] += g[i].real();
+    }
+    if (bn->requires_grad) {
+      bn->ensure_grad();
+      for (int64_t i = 0; i < n; ++i) bn->grad[i] += g[i].imag();
+    }
+  });
   return out;
 }
 
@@ -89,11 +88,11 @@ template <class R> Tensor<R> modulus(const Tensor<std::complex<R>>& z) {
   return out;
 }
 
-#define AG_INSTANTIATE(R)                                                                      \
-  template Tensor<std::complex<R>> complex_from<R>(const Tensor<R>&, const Tensor<R>&);        \
-  template Tensor<std::complex<R>> complex_from_real<R>(const Tensor<R>&);                     \
-  template Tensor<R> real<R>(const Tensor<std::complex<R>>&);                                  \
-  template Tensor<R> imag<R>(const Tensor<std::complex<R>>&);                                  \
+#define AG_INSTANTIATE(R)                                                               \
+  template Tensor<std::complex<R>> complex_from<R>(const Tensor<R>&, const Tensor<R>&); \
+  template Tensor<std::complex<R>> complex_from_real<R>(const Tensor<R>&);              \
+  template Tensor<R> real<R>(const Tensor<std::complex<R>>&);                           \
+  template Tensor<R> imag<R>(const Tensor<std::complex<R>>&);                           \
   template Tensor<R> modulus<R>(const Tensor<std::complex<R>>&);
 AG_INSTANTIATE(float)
 AG_INSTANTIATE(double)

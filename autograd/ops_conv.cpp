@@ -1,5 +1,7 @@
 #include "autograd/ops_conv.hpp"
 
+#include "autograd/gemm_blocks.hpp"
+
 #include <cstring>
 
 namespace ag {
@@ -7,8 +9,7 @@ namespace ag {
 namespace {
 
 void check_4d(const char* op, const Shape& s) {
-  if (s.size() != 4)
-    throw Error(std::string(op) + ": needs a 4-D tensor [N x C x H x W], got " + shape_str(s));
+  if (s.size() != 4) throw Error(std::string(op) + ": needs a 4-D tensor [N x C x H x W], got " + shape_str(s));
 }
 
 // im2col for a 3x3 kernel, stride 1, zero padding 1. img [C x H x W] -> col [(C*9) x (H*W)],
@@ -64,19 +65,17 @@ template <class T> void col2im_add(const T* col, int64_t C, int64_t H, int64_t W
 // Per image n: Y_n [O x HW] = W [O x C9] * col(X_n) [C9 x HW] + b.
 // Backward: dW += G_n col(X_n)^T, db += row sums of G_n, dX_n += col2im(W^T G_n).
 // col(X_n) is recomputed in backward instead of stored (it is 9x the input).
-template <class T>
-Tensor<T> conv2d_3x3(const Tensor<T>& x, const Tensor<T>& weight, const Tensor<T>& bias) {
+template <class T> Tensor<T> conv2d_3x3(const Tensor<T>& x, const Tensor<T>& weight, const Tensor<T>& bias) {
   static_assert(!is_complex_v<T>, "conv2d_3x3: real scalars only");
   check_4d("conv2d_3x3", x.shape());
   check_4d("conv2d_3x3 (weight)", weight.shape());
   const int64_t N = x.size(0), C = x.size(1), H = x.size(2), W = x.size(3);
   const int64_t O = weight.size(0);
   if (weight.size(1) != C || weight.size(2) != 3 || weight.size(3) != 3)
-    throw Error("conv2d_3x3: weight " + shape_str(weight.shape()) + " does not fit input " +
-                shape_str(x.shape()) + " (weight must be [O x C x 3 x 3])");
+    throw Error("conv2d_3x3: weight " + shape_str(weight.shape()) + " does not fit input " + shape_str(x.shape()) +
+                " (weight must be [O x C x 3 x 3])");
   if (bias.defined() && bias.numel() != O)
-    throw Error("conv2d_3x3: bias " + shape_str(bias.shape()) + " does not fit weight " +
-                shape_str(weight.shape()));
+    throw Error("conv2d_3x3: bias " + shape_str(bias.shape()) + " does not fit weight " + shape_str(weight.shape()));
   const int64_t HW = H * W, K = C * 9;
   Tensor<T> out = new_output<T>({N, O, H, W});
   {
@@ -85,16 +84,18 @@ Tensor<T> conv2d_3x3(const Tensor<T>& x, const Tensor<T>& weight, const Tensor<T
     for (int64_t n = 0; n < N; ++n) {
       im2col(x.data() + n * C * HW, C, H, W, col.data());
       MatMap<T> Y(out.data() + n * O * HW, O, HW);
-      Y.noalias() = Wm * ConstMatMap<T>(col.data(), K, HW);
-      if (bias.defined())
-        Y.colwise() += Eigen::Map<const Eigen::Matrix<T, Eigen::Dynamic, 1>>(bias.data(), O);
+      const ConstMatMap<T> Col(col.data(), K, HW);
+      gemm::row_blocks(O, K * HW, [&](int64_t r0, int64_t r1) {
+        Y.middleRows(r0, r1 - r0).noalias() = Wm.middleRows(r0, r1 - r0) * Col;
+      });
+      if (bias.defined()) Y.colwise() += Eigen::Map<const Eigen::Matrix<T, Eigen::Dynamic, 1>>(bias.data(), O);
     }
   }
   std::vector<std::shared_ptr<NodeBase>> parents{x.node_ptr(), weight.node_ptr()};
   if (bias.defined()) parents.push_back(bias.node_ptr());
   record(out.node(), std::move(parents),
-         [xn = &x.node(), wn = &weight.node(), bn = bias.defined() ? &bias.node() : nullptr,
-          on = &out.node(), N, C, H, W, O, HW, K] {
+         [xn = &x.node(), wn = &weight.node(), bn = bias.defined() ? &bias.node() : nullptr, on = &out.node(), N, C, H,
+          W, O, HW, K] {
            if (on->grad.empty()) return;
            const bool need_x = xn->requires_grad, need_w = wn->requires_grad;
            const bool need_b = bn && bn->requires_grad;
@@ -107,13 +108,18 @@ Tensor<T> conv2d_3x3(const Tensor<T>& x, const Tensor<T>& weight, const Tensor<T
              ConstMatMap<T> G(on->grad.data() + n * O * HW, O, HW);
              if (need_w) {
                im2col(xn->value.data() + n * C * HW, C, H, W, col.data());
-               MatMap<T>(wn->grad.data(), O, K).noalias() +=
-                   G * ConstMatMap<T>(col.data(), K, HW).transpose();
+               MatMap<T> dW(wn->grad.data(), O, K);
+               const ConstMatMap<T> Col(col.data(), K, HW);
+               gemm::row_blocks(O, K * HW, [&](int64_t r0, int64_t r1) {
+                 dW.middleRows(r0, r1 - r0).noalias() += G.middleRows(r0, r1 - r0) * Col.transpose();
+               });
              }
-             if (need_b)
-               Eigen::Map<Eigen::Matrix<T, Eigen::Dynamic, 1>>(bn->grad.data(), O) += G.rowwise().sum();
+             if (need_b) Eigen::Map<Eigen::Matrix<T, Eigen::Dynamic, 1>>(bn->grad.data(), O) += G.rowwise().sum();
              if (need_x) {
-               MatMap<T>(col.data(), K, HW).noalias() = Wm.transpose() * G;
+               MatMap<T> Col(col.data(), K, HW);
+               gemm::row_blocks(K, O * HW, [&](int64_t r0, int64_t r1) {
+                 Col.middleRows(r0, r1 - r0).noalias() = Wm.middleCols(r0, r1 - r0).transpose() * G;
+               });
                col2im_add(col.data(), C, H, W, xn->grad.data() + n * C * HW);
              }
            }
@@ -199,9 +205,9 @@ template <class T> Tensor<T> max_pool2x2(const Tensor<T>& x) {
   return out;
 }
 
-#define AG_CONV_INST(T)                                                                 \
+#define AG_CONV_INST(T)                                                                \
   template Tensor<T> conv2d_3x3(const Tensor<T>&, const Tensor<T>&, const Tensor<T>&); \
-  template Tensor<T> avg_pool2x2(const Tensor<T>&);                                     \
+  template Tensor<T> avg_pool2x2(const Tensor<T>&);                                    \
   template Tensor<T> max_pool2x2(const Tensor<T>&);
 AG_CONV_INST(float)
 AG_CONV_INST(double)

@@ -6,8 +6,10 @@ namespace ag {
 namespace {
 
 template <class T> T cj(T x) {
-  if constexpr (is_complex_v<T>) return std::conj(x);
-  else return x;
+  if constexpr (is_complex_v<T>)
+    return std::conj(x);
+  else
+    return x;
 }
 
 // How an operand maps onto the [R x C] result of a broadcasting binary op.
@@ -74,38 +76,36 @@ Tensor<T> binary_op(const char* name, const Tensor<T>& a, const Tensor<T>& b, F 
     for (int64_t r = 0; r < bc.R; ++r)
       for (int64_t c = 0; c < bc.C; ++c) ov[r * bc.C + c] = f(av[bc.a.at(r, c)], bv[bc.b.at(r, c)]);
   }
-  record(out.node(), {a.node_ptr(), b.node_ptr()},
-         [an = &a.node(), bn = &b.node(), on = &out.node(), bc, da, db] {
-           const T* g = on->grad.data();
-           const T* av = an->value.data();
-           const T* bv = bn->value.data();
-           const T* ov = on->value.data();
-           if (an->requires_grad) an->ensure_grad();
-           if (bn->requires_grad) bn->ensure_grad();
-           T* ga = an->requires_grad ? an->grad.data() : nullptr;
-           T* gb = bn->requires_grad ? bn->grad.data() : nullptr;
-           const int64_t n = bc.R * bc.C;
-           if (bc.same) {
+  record(out.node(), {a.node_ptr(), b.node_ptr()}, [an = &a.node(), bn = &b.node(), on = &out.node(), bc, da, db] {
+    const T* g = on->grad.data();
+    const T* av = an->value.data();
+    const T* bv = bn->value.data();
+    const T* ov = on->value.data();
+    if (an->requires_grad) an->ensure_grad();
+    if (bn->requires_grad) bn->ensure_grad();
+    T* ga = an->requires_grad ? an->grad.data() : nullptr;
+    T* gb = bn->requires_grad ? bn->grad.data() : nullptr;
+    const int64_t n = bc.R * bc.C;
+    if (bc.same) {
 #pragma omp parallel for if (n > kParallelMin)
-             for (int64_t i = 0; i < n; ++i) {
-               if (ga) ga[i] += g[i] * cj(da(av[i], bv[i], ov[i]));
-               if (gb) gb[i] += g[i] * cj(db(av[i], bv[i], ov[i]));
-             }
-           } else {  // broadcast operands accumulate: serial
-             for (int64_t r = 0; r < bc.R; ++r)
-               for (int64_t c = 0; c < bc.C; ++c) {
-                 const int64_t i = r * bc.C + c, ia = bc.a.at(r, c), ib = bc.b.at(r, c);
-                 if (ga) ga[ia] += g[i] * cj(da(av[ia], bv[ib], ov[i]));
-                 if (gb) gb[ib] += g[i] * cj(db(av[ia], bv[ib], ov[i]));
-               }
-           }
-         });
+      for (int64_t i = 0; i < n; ++i) {
+        if (ga) ga[i] += g[i] * cj(da(av[i], bv[i], ov[i]));
+        if (gb) gb[i] += g[i] * cj(db(av[i], bv[i], ov[i]));
+      }
+    } else {  // broadcast operands accumulate: serial
+      for (int64_t r = 0; r < bc.R; ++r)
+        for (int64_t c = 0; c < bc.C; ++c) {
+          const int64_t i = r * bc.C + c, ia = bc.a.at(r, c), ib = bc.b.at(r, c);
+          if (ga) ga[ia] += g[i] * cj(da(av[ia], bv[ib], ov[i]));
+          if (gb) gb[ib] += g[i] * cj(db(av[ia], bv[ib], ov[i]));
+        }
+    }
+  });
   return out;
 }
 
 // f(x) -> value; df(x, y) -> dy/dx.
-template <class T, class F, class DF>
-Tensor<T> unary_op(const Tensor<T>& x, F f, DF df) {
+template <class T, class F, class DF> Tensor<T> unary_op(const Tensor<T>& x, F f, DF df) {
   Tensor<T> out = new_output<T>(x.shape());
   const T* xv = x.data();
   T* ov = out.data();
@@ -129,67 +129,79 @@ Tensor<T> unary_op(const Tensor<T>& x, F f, DF df) {
 
 // ---- binary -------------------------------------------------------------------------------
 template <class T> Tensor<T> add(const Tensor<T>& a, const Tensor<T>& b) {
-  return binary_op<T>("add", a, b, [](T x, T y) { return x + y; },
-                      [](T, T, T) { return T(1); }, [](T, T, T) { return T(1); });
+  return binary_op<T>(
+      "add", a, b, [](T x, T y) { return x + y; }, [](T, T, T) { return T(1); }, [](T, T, T) { return T(1); });
 }
 template <class T> Tensor<T> sub(const Tensor<T>& a, const Tensor<T>& b) {
-  return binary_op<T>("sub", a, b, [](T x, T y) { return x - y; },
-                      [](T, T, T) { return T(1); }, [](T, T, T) { return T(-1); });
+  return binary_op<T>(
+      "sub", a, b, [](T x, T y) { return x - y; }, [](T, T, T) { return T(1); }, [](T, T, T) { return T(-1); });
 }
 template <class T> Tensor<T> mul(const Tensor<T>& a, const Tensor<T>& b) {
-  return binary_op<T>("mul", a, b, [](T x, T y) { return x * y; },
-                      [](T, T y, T) { return y; }, [](T x, T, T) { return x; });
+  return binary_op<T>(
+      "mul", a, b, [](T x, T y) { return x * y; }, [](T, T y, T) { return y; }, [](T x, T, T) { return x; });
 }
 template <class T> Tensor<T> div(const Tensor<T>& a, const Tensor<T>& b) {
-  return binary_op<T>("div", a, b, [](T x, T y) { return x / y; },
-                      [](T, T y, T) { return T(1) / y; }, [](T, T y, T o) { return -o / y; });
+  return binary_op<T>(
+      "div", a, b, [](T x, T y) { return x / y; }, [](T, T y, T) { return T(1) / y; },
+      [](T, T y, T o) { return -o / y; });
 }
 template <class T> Tensor<T> neg(const Tensor<T>& a) {
-  return unary_op<T>(a, [](T x) { return -x; }, [](T, T) { return T(-1); });
+  return unary_op<T>(
+      a, [](T x) { return -x; }, [](T, T) { return T(-1); });
 }
 template <class T> Tensor<T> add_scalar(const Tensor<T>& a, T s) {
-  return unary_op<T>(a, [s](T x) { return x + s; }, [](T, T) { return T(1); });
+  return unary_op<T>(
+      a, [s](T x) { return x + s; }, [](T, T) { return T(1); });
 }
 template <class T> Tensor<T> mul_scalar(const Tensor<T>& a, T s) {
-  return unary_op<T>(a, [s](T x) { return x * s; }, [s](T, T) { return s; });
+  return unary_op<T>(
+      a, [s](T x) { return x * s; }, [s](T, T) { return s; });
 }
 
 // ---- unary (real) ----------------------------------------------------------------------------
 template <class T> Tensor<T> exp(const Tensor<T>& x) {
-  return unary_op<T>(x, [](T v) { return std::exp(v); }, [](T, T y) { return y; });
+  return unary_op<T>(
+      x, [](T v) { return std::exp(v); }, [](T, T y) { return y; });
 }
 template <class T> Tensor<T> log(const Tensor<T>& x) {
-  return unary_op<T>(x, [](T v) { return std::log(v); }, [](T v, T) { return T(1) / v; });
+  return unary_op<T>(
+      x, [](T v) { return std::log(v); }, [](T v, T) { return T(1) / v; });
 }
 template <class T> Tensor<T> sqrt(const Tensor<T>& x) {
-  return unary_op<T>(x, [](T v) { return std::sqrt(v); }, [](T, T y) { return T(0.5) / y; });
+  return unary_op<T>(
+      x, [](T v) { return std::sqrt(v); }, [](T, T y) { return T(0.5) / y; });
 }
 template <class T> Tensor<T> sin(const Tensor<T>& x) {
-  return unary_op<T>(x, [](T v) { return std::sin(v); }, [](T v, T) { return std::cos(v); });
+  return unary_op<T>(
+      x, [](T v) { return std::sin(v); }, [](T v, T) { return std::cos(v); });
 }
 template <class T> Tensor<T> cos(const Tensor<T>& x) {
-  return unary_op<T>(x, [](T v) { return std::cos(v); }, [](T v, T) { return -std::sin(v); });
+  return unary_op<T>(
+      x, [](T v) { return std::cos(v); }, [](T v, T) { return -std::sin(v); });
 }
 template <class T> Tensor<T> tanh(const Tensor<T>& x) {
-  return unary_op<T>(x, [](T v) { return std::tanh(v); }, [](T, T y) { return T(1) - y * y; });
+  return unary_op<T>(
+      x, [](T v) { return std::tanh(v); }, [](T, T y) { return T(1) - y * y; });
 }
 template <class T> Tensor<T> abs(const Tensor<T>& x) {
-  return unary_op<T>(x, [](T v) { return std::abs(v); },
-                     [](T v, T) { return v > 0 ? T(1) : (v < 0 ? T(-1) : T(0)); });
+  return unary_op<T>(
+      x, [](T v) { return std::abs(v); }, [](T v, T) { return v > 0 ? T(1) : (v < 0 ? T(-1) : T(0)); });
 }
 template <class T> Tensor<T> square(const Tensor<T>& x) {
-  return unary_op<T>(x, [](T v) { return v * v; }, [](T v, T) { return T(2) * v; });
+  return unary_op<T>(
+      x, [](T v) { return v * v; }, [](T v, T) { return T(2) * v; });
 }
 template <class T> Tensor<T> pow(const Tensor<T>& x, T p) {
-  return unary_op<T>(x, [p](T v) { return std::pow(v, p); },
-                     [p](T v, T) { return p == T(0) ? T(0) : p * std::pow(v, p - T(1)); });
+  return unary_op<T>(
+      x, [p](T v) { return std::pow(v, p); }, [p](T v, T) { return p == T(0) ? T(0) : p * std::pow(v, p - T(1)); });
 }
 template <class T> Tensor<T> relu(const Tensor<T>& x) {
-  return unary_op<T>(x, [](T v) { return v > 0 ? v : T(0); }, [](T v, T) { return v > 0 ? T(1) : T(0); });
+  return unary_op<T>(
+      x, [](T v) { return v > 0 ? v : T(0); }, [](T v, T) { return v > 0 ? T(1) : T(0); });
 }
 template <class T> Tensor<T> leaky_relu(const Tensor<T>& x, T slope) {
-  return unary_op<T>(x, [slope](T v) { return v > 0 ? v : slope * v; },
-                     [slope](T v, T) { return v > 0 ? T(1) : slope; });
+  return unary_op<T>(
+      x, [slope](T v) { return v > 0 ? v : slope * v; }, [slope](T v, T) { return v > 0 ? T(1) : slope; });
 }
 template <class T> Tensor<T> sigmoid(const Tensor<T>& x) {
   // Written so that neither branch overflows exp.
@@ -204,8 +216,9 @@ template <class T> Tensor<T> sigmoid(const Tensor<T>& x) {
 }
 template <class T> Tensor<T> clamp(const Tensor<T>& x, T lo, T hi) {
   if (!(lo <= hi)) throw Error("clamp: lower bound above upper bound");
-  return unary_op<T>(x, [lo, hi](T v) { return v < lo ? lo : (v > hi ? hi : v); },
-                     [lo, hi](T v, T) { return (v < lo || v > hi) ? T(0) : T(1); });
+  return unary_op<T>(
+      x, [lo, hi](T v) { return v < lo ? lo : (v > hi ? hi : v); },
+      [lo, hi](T v, T) { return (v < lo || v > hi) ? T(0) : T(1); });
 }
 
 // atan2(y, x): d/dy = x / r^2, d/dx = -y / r^2, r^2 = x^2 + y^2; both 0 at the origin.
@@ -223,28 +236,28 @@ template <class T> Tensor<T> atan2(const Tensor<T>& y, const Tensor<T>& x) {
       });
 }
 
-#define AG_ANY(T)                                                          \
-  template Tensor<T> add(const Tensor<T>&, const Tensor<T>&);              \
-  template Tensor<T> sub(const Tensor<T>&, const Tensor<T>&);              \
-  template Tensor<T> mul(const Tensor<T>&, const Tensor<T>&);              \
-  template Tensor<T> div(const Tensor<T>&, const Tensor<T>&);              \
-  template Tensor<T> neg(const Tensor<T>&);                                \
-  template Tensor<T> add_scalar(const Tensor<T>&, T);                      \
+#define AG_ANY(T)                                             \
+  template Tensor<T> add(const Tensor<T>&, const Tensor<T>&); \
+  template Tensor<T> sub(const Tensor<T>&, const Tensor<T>&); \
+  template Tensor<T> mul(const Tensor<T>&, const Tensor<T>&); \
+  template Tensor<T> div(const Tensor<T>&, const Tensor<T>&); \
+  template Tensor<T> neg(const Tensor<T>&);                   \
+  template Tensor<T> add_scalar(const Tensor<T>&, T);         \
   template Tensor<T> mul_scalar(const Tensor<T>&, T);
-#define AG_REAL(T)                                                         \
-  template Tensor<T> exp(const Tensor<T>&);                                \
-  template Tensor<T> log(const Tensor<T>&);                                \
-  template Tensor<T> sqrt(const Tensor<T>&);                               \
-  template Tensor<T> sin(const Tensor<T>&);                                \
-  template Tensor<T> cos(const Tensor<T>&);                                \
-  template Tensor<T> tanh(const Tensor<T>&);                               \
-  template Tensor<T> abs(const Tensor<T>&);                                \
-  template Tensor<T> square(const Tensor<T>&);                             \
-  template Tensor<T> pow(const Tensor<T>&, T);                             \
-  template Tensor<T> relu(const Tensor<T>&);                               \
-  template Tensor<T> leaky_relu(const Tensor<T>&, T);                      \
-  template Tensor<T> sigmoid(const Tensor<T>&);                            \
-  template Tensor<T> clamp(const Tensor<T>&, T, T);                        \
+#define AG_REAL(T)                                    \
+  template Tensor<T> exp(const Tensor<T>&);           \
+  template Tensor<T> log(const Tensor<T>&);           \
+  template Tensor<T> sqrt(const Tensor<T>&);          \
+  template Tensor<T> sin(const Tensor<T>&);           \
+  template Tensor<T> cos(const Tensor<T>&);           \
+  template Tensor<T> tanh(const Tensor<T>&);          \
+  template Tensor<T> abs(const Tensor<T>&);           \
+  template Tensor<T> square(const Tensor<T>&);        \
+  template Tensor<T> pow(const Tensor<T>&, T);        \
+  template Tensor<T> relu(const Tensor<T>&);          \
+  template Tensor<T> leaky_relu(const Tensor<T>&, T); \
+  template Tensor<T> sigmoid(const Tensor<T>&);       \
+  template Tensor<T> clamp(const Tensor<T>&, T, T);   \
   template Tensor<T> atan2(const Tensor<T>&, const Tensor<T>&);
 
 AG_ANY(float)

@@ -40,7 +40,7 @@ template <class T> Tensor<T> pow(const Tensor<T>& x, T p);  // x^p; for non-inte
 template <class T> Tensor<T> relu(const Tensor<T>& x);
 template <class T> Tensor<T> leaky_relu(const Tensor<T>& x, T slope);
 template <class T> Tensor<T> sigmoid(const Tensor<T>& x);
-template <class T> Tensor<T> clamp(const Tensor<T>& x, T lo, T hi);  // gradient 0 outside [lo, hi]
+template <class T> Tensor<T> clamp(const Tensor<T>& x, T lo, T hi);          // gradient 0 outside [lo, hi]
 template <class T> Tensor<T> atan2(const Tensor<T>& y, const Tensor<T>& x);  // same shapes; grad at (0,0) taken as 0
 
 }  // namespace ag

@@ -7,26 +7,57 @@ namespace ag {
 namespace {
 
 template <class T> T conj_if(const T& v) {
-  if constexpr (is_complex_v<T>) return std::conj(v);
-  else return v;
+  if constexpr (is_complex_v<T>)
+    return std::conj(v);
+  else
+    return v;
 }
 
 void check_index(const char* op, const Index& index, int64_t bound, const Shape& x_shape) {
   for (size_t i = 0; i < index.size(); ++i)
     if (index[i] < 0 || index[i] >= bound)
-      throw Error(std::string(op) + ": index " + std::to_string(index[i]) + " at position " +
-                  std::to_string(i) + " outside [0, " + std::to_string(bound) + ") for " +
-                  shape_str(x_shape));
+      throw Error(std::string(op) + ": index " + std::to_string(index[i]) + " at position " + std::to_string(i) +
+                  " outside [0, " + std::to_string(bound) + ") for " + shape_str(x_shape));
 }
 
-// rows[i] += src[i'] for every (i <- index), serial: several sources may hit one row.
-template <class T>
-void scatter_add_serial(T* dst, const T* src, const Index& index, int64_t C) {
+// Receivers of a scatter in compressed-row form: the positions p of `index` with
+// index[p] == r are pos[offset[r] .. offset[r+1]), in increasing p (a stable counting sort).
+// Summing each receiver's sources in that order gives the serial loop's result bit for bit,
+// whatever the number of threads: every output row is owned by one thread.
+struct Csr {
+  std::vector<int64_t> offset, pos;
+};
+
+Csr make_csr(const Index& index, int64_t num_rows) {
+  Csr c;
+  c.offset.assign(static_cast<size_t>(num_rows + 1), 0);
+  for (int64_t r : index) ++c.offset[r + 1];
+  for (int64_t r = 0; r < num_rows; ++r) c.offset[r + 1] += c.offset[r];
+  c.pos.resize(index.size());
+  std::vector<int64_t> next(c.offset.begin(), c.offset.end() - 1);
+  for (size_t p = 0; p < index.size(); ++p) c.pos[next[index[p]]++] = static_cast<int64_t>(p);
+  return c;
+}
+
+// dst[index[p]] += src[p] (rows of width C) as a segment sum: parallel over receivers,
+// deterministic. `scale`, if given, multiplies each receiver's row afterwards (scatter_mean;
+// dst must then start at 0).
+template <class T> void scatter_add_csr(T* dst, const T* src, const Index& index, int64_t num_rows, int64_t C,
+                                        const real_t<T>* scale = nullptr) {
+  if (index.empty()) return;
+  const Csr c = make_csr(index, num_rows);
   const int64_t n = static_cast<int64_t>(index.size());
-  for (int64_t i = 0; i < n; ++i) {
-    T* d = dst + index[i] * C;
-    const T* s = src + i * C;
-    for (int64_t j = 0; j < C; ++j) d[j] += s[j];
+#pragma omp parallel for schedule(static) if (n * C > kParallelMin)
+  for (int64_t r = 0; r < num_rows; ++r) {
+    const int64_t b = c.offset[r], e = c.offset[r + 1];
+    if (b == e) continue;
+    T* d = dst + r * C;
+    for (int64_t k = b; k < e; ++k) {
+      const T* s = src + c.pos[k] * C;
+      for (int64_t j = 0; j < C; ++j) d[j] += s[j];
+    }
+    if (scale)
+      for (int64_t j = 0; j < C; ++j) d[j] *= scale[r];
   }
 }
 
@@ -45,7 +76,7 @@ template <class T> Tensor<T> index_select_rows(const Tensor<T>& x, const Index& 
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), index, C] {
     if (!xn->requires_grad) return;
     xn->ensure_grad();
-    scatter_add_serial(xn->grad.data(), on->grad.data(), index, C);
+    scatter_add_csr(xn->grad.data(), on->grad.data(), index, xn->shape[0], C);
   });
   return out;
 }
@@ -60,12 +91,11 @@ static void check_scatter(const char* op, const Shape& xs, const Index& index, i
 }
 
 // ---- scatter_add_rows (segment sum) -----------------------------------------------------------
-template <class T>
-Tensor<T> scatter_add_rows(const Tensor<T>& x, const Index& index, int64_t num_rows) {
+template <class T> Tensor<T> scatter_add_rows(const Tensor<T>& x, const Index& index, int64_t num_rows) {
   check_scatter("scatter_add_rows", x.shape(), index, num_rows);
   const int64_t N = x.rows(), C = x.cols();
   auto out = new_output<T>({num_rows, C});
-  scatter_add_serial(out.data(), x.data(), index, C);
+  scatter_add_csr(out.data(), x.data(), index, num_rows, C);
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), index, C, N] {
     if (!xn->requires_grad) return;
     xn->ensure_grad();
@@ -81,19 +111,14 @@ Tensor<T> scatter_add_rows(const Tensor<T>& x, const Index& index, int64_t num_r
 }
 
 // ---- scatter_mean_rows --------------------------------------------------------------------------
-template <class T>
-Tensor<T> scatter_mean_rows(const Tensor<T>& x, const Index& index, int64_t num_rows) {
+template <class T> Tensor<T> scatter_mean_rows(const Tensor<T>& x, const Index& index, int64_t num_rows) {
   check_scatter("scatter_mean_rows", x.shape(), index, num_rows);
   const int64_t N = x.rows(), C = x.cols();
   std::vector<real_t<T>> inv(static_cast<size_t>(num_rows), 0);
   for (int64_t i : index) inv[i] += 1;
   for (auto& v : inv) v = v > 0 ? real_t<T>(1) / v : real_t<T>(0);
   auto out = new_output<T>({num_rows, C});
-  T* o = out.data();
-  scatter_add_serial(o, x.data(), index, C);
-#pragma omp parallel for if (num_rows * C > kParallelMin)
-  for (int64_t r = 0; r < num_rows; ++r)
-    for (int64_t j = 0; j < C; ++j) o[r * C + j] *= inv[r];
+  scatter_add_csr(out.data(), x.data(), index, num_rows, C, inv.data());
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), index, inv, C, N] {
     if (!xn->requires_grad) return;
     xn->ensure_grad();
@@ -110,14 +135,13 @@ Tensor<T> scatter_mean_rows(const Tensor<T>& x, const Index& index, int64_t num_
 }
 
 // ---- interpolate_rows ---------------------------------------------------------------------------
-template <class T>
-Tensor<T> interpolate_rows(const Tensor<T>& x, const Index& index, const Tensor<T>& weight) {
+template <class T> Tensor<T> interpolate_rows(const Tensor<T>& x, const Index& index, const Tensor<T>& weight) {
   check_2d("interpolate_rows", x.shape());
   check_2d("interpolate_rows", weight.shape());
   const int64_t R = x.rows(), C = x.cols(), N = weight.rows(), K = weight.cols();
   if (static_cast<int64_t>(index.size()) != N * K)
-    throw Error("interpolate_rows: " + std::to_string(index.size()) +
-                " indices for weight " + shape_str(weight.shape()) + " (need rows*cols)");
+    throw Error("interpolate_rows: " + std::to_string(index.size()) + " indices for weight " +
+                shape_str(weight.shape()) + " (need rows*cols)");
   check_index("interpolate_rows", index, R, x.shape());
   auto out = new_output<T>({N, C});
   const T* xs = x.data();
@@ -139,7 +163,7 @@ Tensor<T> interpolate_rows(const Tensor<T>& x, const Index& index, const Tensor<
              wn->ensure_grad();
              const T* xs = xn->value.data();
              T* gw = wn->grad.data();
-             // d/dw[i,k] = <x[idx], g[i]> (conjugated on x for complex: grad = conj(x) g).
+      // d/dw[i,k] = <x[idx], g[i]> (conjugated on x for complex: grad = conj(x) g).
 #pragma omp parallel for if (N * K * C > kParallelMin)
              for (int64_t i = 0; i < N; ++i)
                for (int64_t k = 0; k < K; ++k) {
@@ -153,21 +177,28 @@ Tensor<T> interpolate_rows(const Tensor<T>& x, const Index& index, const Tensor<
              xn->ensure_grad();
              const T* w = wn->value.data();
              T* gx = xn->grad.data();
-             for (int64_t i = 0; i < N; ++i)
-               for (int64_t k = 0; k < K; ++k) {
-                 const T wk = conj_if(w[i * K + k]);
-                 T* d = gx + index[i * K + k] * C;
-                 for (int64_t j = 0; j < C; ++j) d[j] += wk * go[i * C + j];
+             // Segment sum over the receivers x[index[p]], p = i*K + k (as scatter_add_csr).
+             const int64_t R = xn->shape[0];
+             const Csr c = make_csr(index, R);
+#pragma omp parallel for schedule(static) if (N * K * C > kParallelMin)
+             for (int64_t r = 0; r < R; ++r) {
+               T* d = gx + r * C;
+               for (int64_t q = c.offset[r]; q < c.offset[r + 1]; ++q) {
+                 const int64_t p = c.pos[q];
+                 const T wk = conj_if(w[p]);
+                 const T* g = go + (p / K) * C;
+                 for (int64_t j = 0; j < C; ++j) d[j] += wk * g[j];
                }
+             }
            }
          });
   return out;
 }
 
-#define AG_INSTANTIATE(T)                                                                 \
-  template Tensor<T> index_select_rows<T>(const Tensor<T>&, const Index&);                \
-  template Tensor<T> scatter_add_rows<T>(const Tensor<T>&, const Index&, int64_t);        \
-  template Tensor<T> scatter_mean_rows<T>(const Tensor<T>&, const Index&, int64_t);       \
+#define AG_INSTANTIATE(T)                                                           \
+  template Tensor<T> index_select_rows<T>(const Tensor<T>&, const Index&);          \
+  template Tensor<T> scatter_add_rows<T>(const Tensor<T>&, const Index&, int64_t);  \
+  template Tensor<T> scatter_mean_rows<T>(const Tensor<T>&, const Index&, int64_t); \
   template Tensor<T> interpolate_rows<T>(const Tensor<T>&, const Index&, const Tensor<T>&);
 AG_INSTANTIATE(float)
 AG_INSTANTIATE(double)

@@ -15,7 +15,6 @@ template <class T> Tensor<T> scatter_mean_rows(const Tensor<T>& x, const Index& 
 // out[i] = sum_k weight[i,k] * x[index[i,k]]: x [R x C], index [N x K] row-major (K per row),
 // weight [N x K] tensor (differentiable too) -> [N x C]. Barycentric interpolation
 // (K = 3) for upsampling and for drawing normal maps from a UV raster.
-template <class T>
-Tensor<T> interpolate_rows(const Tensor<T>& x, const Index& index, const Tensor<T>& weight);
+template <class T> Tensor<T> interpolate_rows(const Tensor<T>& x, const Index& index, const Tensor<T>& weight);
 
 }  // namespace ag

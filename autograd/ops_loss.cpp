@@ -12,8 +12,7 @@ template <class T> void check_loss(const char* op, const Tensor<T>& p, const Ten
 }
 
 // Shared backward: d/dp = g * dphi(p - t) / n, d/dt = -that.
-template <class T, class D>
-void record_loss(Tensor<T>& out, const Tensor<T>& pred, const Tensor<T>& target, D dphi) {
+template <class T, class D> void record_loss(Tensor<T>& out, const Tensor<T>& pred, const Tensor<T>& target, D dphi) {
   record(out.node(), {pred.node_ptr(), target.node_ptr()},
          [pn = &pred.node(), tn = &target.node(), on = &out.node(), dphi] {
            const int64_t n = static_cast<int64_t>(pn->value.size());

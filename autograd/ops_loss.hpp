@@ -6,7 +6,7 @@
 
 namespace ag {
 
-template <class T> Tensor<T> l1_loss(const Tensor<T>& pred, const Tensor<T>& target);  // mean |p - t|
-template <class T> Tensor<T> mse_loss(const Tensor<T>& pred, const Tensor<T>& target); // mean (p - t)^2
+template <class T> Tensor<T> l1_loss(const Tensor<T>& pred, const Tensor<T>& target);   // mean |p - t|
+template <class T> Tensor<T> mse_loss(const Tensor<T>& pred, const Tensor<T>& target);  // mean (p - t)^2
 
 }  // namespace ag

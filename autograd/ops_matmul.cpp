@@ -1,6 +1,12 @@
 #include "autograd/ops_matmul.hpp"
 
+#include "autograd/gemm_blocks.hpp"
+
+#include <algorithm>
+#include <string>
+
 namespace ag {
+using gemm::row_blocks;
 
 // C = A B.  dA = G B^H,  dB = A^H G  (H = conjugate transpose; plain transpose for reals).
 template <class T> Tensor<T> matmul(const Tensor<T>& a, const Tensor<T>& b) {
@@ -9,36 +15,87 @@ template <class T> Tensor<T> matmul(const Tensor<T>& a, const Tensor<T>& b) {
   if (a.cols() != b.rows())
     throw Error("matmul: inner sizes differ, " + shape_str(a.shape()) + " x " + shape_str(b.shape()));
   Tensor<T> out = new_output<T>({a.rows(), b.cols()});
-  out.mat().noalias() = a.mat() * b.mat();
+  {
+    MatMap<T> C = out.mat();
+    const ConstMatMap<T> A = a.mat(), B = b.mat();
+    row_blocks(A.rows(), A.cols() * B.cols(), [&](int64_t r0, int64_t r1) {
+      C.middleRows(r0, r1 - r0).noalias() += A.middleRows(r0, r1 - r0) * B;  // output zeroed already
+    });
+  }
   record(out.node(), {a.node_ptr(), b.node_ptr()}, [an = &a.node(), bn = &b.node(), on = &out.node()] {
     const int64_t M = an->shape[0], K = an->shape[1], N = bn->shape[1];
     ConstMatMap<T> A(an->value.data(), M, K), B(bn->value.data(), K, N), G(on->grad.data(), M, N);
     if (an->requires_grad) {
       an->ensure_grad();
-      MatMap<T>(an->grad.data(), M, K).noalias() += G * B.adjoint();
+      MatMap<T> dA(an->grad.data(), M, K);
+      row_blocks(M, K * N, [&](int64_t r0, int64_t r1) {
+        dA.middleRows(r0, r1 - r0).noalias() += G.middleRows(r0, r1 - r0) * B.adjoint();
+      });
     }
     if (bn->requires_grad) {
       bn->ensure_grad();
-      MatMap<T>(bn->grad.data(), K, N).noalias() += A.adjoint() * G;
+      MatMap<T> dB(bn->grad.data(), K, N);
+      row_blocks(K, M * N, [&](int64_t r0, int64_t r1) {
+        dB.middleRows(r0, r1 - r0).noalias() += A.middleCols(r0, r1 - r0).adjoint() * G;
+      });
     }
   });
   return out;
 }
 
-// Y = X W^T + b.  dX = G conj(W),  dW = G^T conj(X),  db = column sums of G.
+namespace {
 template <class T>
-Tensor<T> linear(const Tensor<T>& x, const Tensor<T>& weight, const Tensor<T>& bias) {
-  check_2d("linear", x.shape());
-  check_2d("linear", weight.shape());
+void check_linear(const char* op, const Tensor<T>& x, const Tensor<T>& weight, const Tensor<T>& bias) {
+  check_2d(op, x.shape());
+  check_2d(op, weight.shape());
   if (x.cols() != weight.cols())
-    throw Error("linear: input " + shape_str(x.shape()) + " does not fit weight " + shape_str(weight.shape()) +
-                " (weight is out x in)");
+    throw Error(std::string(op) + ": input " + shape_str(x.shape()) + " does not fit weight " +
+                shape_str(weight.shape()) + " (weight is out x in)");
+  if (bias.defined() && bias.numel() != weight.rows())
+    throw Error(std::string(op) + ": bias " + shape_str(bias.shape()) + " does not fit weight " +
+                shape_str(weight.shape()));
+}
+
+// Gradients of Y = X W^T + b for the output gradient G: dX = G conj(W), dW = G^T conj(X),
+// db = column sums of G.
+template <class T> void linear_backward(Node<T>& xn, Node<T>& wn, Node<T>* bn, const T* g) {
+  const int64_t N = xn.shape[0], I = xn.shape[1], O = wn.shape[0];
+  ConstMatMap<T> X(xn.value.data(), N, I), W(wn.value.data(), O, I), G(g, N, O);
+  if (xn.requires_grad) {
+    xn.ensure_grad();
+    MatMap<T> dX(xn.grad.data(), N, I);
+    row_blocks(N, O * I, [&](int64_t r0, int64_t r1) {
+      dX.middleRows(r0, r1 - r0).noalias() += G.middleRows(r0, r1 - r0) * W.conjugate();
+    });
+  }
+  if (wn.requires_grad) {
+    wn.ensure_grad();
+    MatMap<T> dW(wn.grad.data(), O, I);
+    row_blocks(O, N * I, [&](int64_t r0, int64_t r1) {
+      dW.middleRows(r0, r1 - r0).noalias() += G.middleCols(r0, r1 - r0).transpose() * X.conjugate();
+    });
+  }
+  if (bn && bn->requires_grad) {
+    bn->ensure_grad();
+    Eigen::Map<Eigen::Matrix<T, 1, Eigen::Dynamic>>(bn->grad.data(), O) += G.colwise().sum();
+  }
+}
+// Y += X W^T in row blocks (Y is a fresh, zeroed output).
+template <class T> void gemm_xwt(const Tensor<T>& x, const Tensor<T>& weight, MatMap<T>& Y) {
+  const ConstMatMap<T> X = x.mat(), W = weight.mat();
+  row_blocks(X.rows(), X.cols() * W.rows(), [&](int64_t r0, int64_t r1) {
+    Y.middleRows(r0, r1 - r0).noalias() += X.middleRows(r0, r1 - r0) * W.transpose();
+  });
+}
+}  // namespace
+
+// Y = X W^T + b.  dX = G conj(W),  dW = G^T conj(X),  db = column sums of G.
+template <class T> Tensor<T> linear(const Tensor<T>& x, const Tensor<T>& weight, const Tensor<T>& bias) {
+  check_linear("linear", x, weight, bias);
   const int64_t out_f = weight.rows();
-  if (bias.defined() && bias.numel() != out_f)
-    throw Error("linear: bias " + shape_str(bias.shape()) + " does not fit weight " + shape_str(weight.shape()));
   Tensor<T> out = new_output<T>({x.rows(), out_f});
   MatMap<T> Y = out.mat();
-  Y.noalias() = x.mat() * weight.mat().transpose();
+  gemm_xwt(x, weight, Y);
   if (bias.defined()) {
     Eigen::Map<const Eigen::Matrix<T, 1, Eigen::Dynamic>> bv(bias.data(), out_f);
     Y.rowwise() += bv;
@@ -47,20 +104,46 @@ Tensor<T> linear(const Tensor<T>& x, const Tensor<T>& weight, const Tensor<T>& b
   if (bias.defined()) parents.push_back(bias.node_ptr());
   record(out.node(), std::move(parents),
          [xn = &x.node(), wn = &weight.node(), bn = bias.defined() ? &bias.node() : nullptr, on = &out.node()] {
-           const int64_t N = xn->shape[0], I = xn->shape[1], O = wn->shape[0];
-           ConstMatMap<T> X(xn->value.data(), N, I), W(wn->value.data(), O, I), G(on->grad.data(), N, O);
-           if (xn->requires_grad) {
-             xn->ensure_grad();
-             MatMap<T>(xn->grad.data(), N, I).noalias() += G * W.conjugate();
-           }
-           if (wn->requires_grad) {
-             wn->ensure_grad();
-             MatMap<T>(wn->grad.data(), O, I).noalias() += G.transpose() * X.conjugate();
-           }
-           if (bn && bn->requires_grad) {
-             bn->ensure_grad();
-             Eigen::Map<Eigen::Matrix<T, 1, Eigen::Dynamic>>(bn->grad.data(), O) += G.colwise().sum();
-           }
+           linear_backward<T>(*xn, *wn, bn, on->grad.data());
+         });
+  return out;
+}
+
+template <class T>
+Tensor<T> linear_leaky_relu(const Tensor<T>& x, const Tensor<T>& weight, const Tensor<T>& bias, T slope) {
+  static_assert(!is_complex_v<T>, "linear_leaky_relu: real scalars only");
+  check_linear("linear_leaky_relu", x, weight, bias);
+  if (!(slope > 0)) throw Error("linear_leaky_relu: slope must be > 0, got " + std::to_string(slope));
+  const int64_t N = x.rows(), out_f = weight.rows();
+  Tensor<T> out = new_output<T>({N, out_f});
+  {
+    MatMap<T> Y = out.mat();
+    gemm_xwt(x, weight, Y);
+  }
+  {
+    T* y = out.data();
+    const T* b = bias.defined() ? bias.data() : nullptr;
+#pragma omp parallel for if (N * out_f > kParallelMin)
+    for (int64_t r = 0; r < N; ++r) {
+      T* yr = y + r * out_f;
+      for (int64_t c = 0; c < out_f; ++c) {
+        const T v = b ? yr[c] + b[c] : yr[c];
+        yr[c] = v > 0 ? v : slope * v;
+      }
+    }
+  }
+  std::vector<std::shared_ptr<NodeBase>> parents{x.node_ptr(), weight.node_ptr()};
+  if (bias.defined()) parents.push_back(bias.node_ptr());
+  record(out.node(), std::move(parents),
+         [xn = &x.node(), wn = &weight.node(), bn = bias.defined() ? &bias.node() : nullptr, on = &out.node(), slope] {
+           // Gradient before the activation: g * (y > 0 ? 1 : slope) (y > 0 iff x W^T + b > 0).
+           const int64_t n = static_cast<int64_t>(on->value.size());
+           std::vector<T> g(static_cast<size_t>(n));
+           const T* y = on->value.data();
+           const T* go = on->grad.data();
+#pragma omp parallel for if (n > kParallelMin)
+           for (int64_t i = 0; i < n; ++i) g[i] = y[i] > 0 ? go[i] : slope * go[i];
+           linear_backward<T>(*xn, *wn, bn, g.data());
          });
   return out;
 }
@@ -77,8 +160,11 @@ template <class T> Tensor<T> transpose(const Tensor<T>& a) {
   return out;
 }
 
-#define AG_INST(T)                                                              \
-  template Tensor<T> matmul(const Tensor<T>&, const Tensor<T>&);                \
+template Tensor<float> linear_leaky_relu(const Tensor<float>&, const Tensor<float>&, const Tensor<float>&, float);
+template Tensor<double> linear_leaky_relu(const Tensor<double>&, const Tensor<double>&, const Tensor<double>&, double);
+
+#define AG_INST(T)                                                                 \
+  template Tensor<T> matmul(const Tensor<T>&, const Tensor<T>&);                   \
   template Tensor<T> linear(const Tensor<T>&, const Tensor<T>&, const Tensor<T>&); \
   template Tensor<T> transpose(const Tensor<T>&);
 AG_INST(float)

@@ -9,8 +9,7 @@ namespace {
 // Column sums over row blocks of fixed size, combined in block order: deterministic for
 // any thread count. add_row(r, acc) adds row r's contribution into acc[0 .. width).
 constexpr int64_t kBlock = 512;
-template <class T, class F>
-std::vector<T> column_reduce(int64_t R, int64_t width, int64_t work_per_row, F add_row) {
+template <class T, class F> std::vector<T> column_reduce(int64_t R, int64_t width, int64_t work_per_row, F add_row) {
   const int64_t nb = (R + kBlock - 1) / kBlock;
   std::vector<T> part(static_cast<size_t>(std::max<int64_t>(nb, 1) * width), T(0));
 #pragma omp parallel for schedule(static) if (R * work_per_row > kParallelMin)
@@ -97,33 +96,31 @@ template <class T> Tensor<T> layer_norm(const Tensor<T>& x, T eps) {
     inv[r] = T(1) / std::sqrt(v / T(C) + eps);
     for (int64_t j = 0; j < C; ++j) o[r * C + j] = (xr[j] - m) * inv[r];
   }
-  record(out.node(), {x.node_ptr()},
-         [xn = &x.node(), on = &out.node(), inv = std::move(inv), R, C] {
-           if (!xn->requires_grad) return;
-           xn->ensure_grad();
-           const T* g = on->grad.data();
-           const T* y = on->value.data();
-           T* gx = xn->grad.data();
+  record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), inv = std::move(inv), R, C] {
+    if (!xn->requires_grad) return;
+    xn->ensure_grad();
+    const T* g = on->grad.data();
+    const T* y = on->value.data();
+    T* gx = xn->grad.data();
 #pragma omp parallel for if (R * C > kParallelMin)
-           for (int64_t r = 0; r < R; ++r) {
-             const T* gr = g + r * C;
-             const T* yr = y + r * C;
-             T mg = 0, mgy = 0;
-             for (int64_t j = 0; j < C; ++j) {
-               mg += gr[j];
-               mgy += gr[j] * yr[j];
-             }
-             mg /= T(C);
-             mgy /= T(C);
-             for (int64_t j = 0; j < C; ++j)
-               gx[r * C + j] += inv[r] * (gr[j] - mg - yr[j] * mgy);
-           }
-         });
+    for (int64_t r = 0; r < R; ++r) {
+      const T* gr = g + r * C;
+      const T* yr = y + r * C;
+      T mg = 0, mgy = 0;
+      for (int64_t j = 0; j < C; ++j) {
+        mg += gr[j];
+        mgy += gr[j] * yr[j];
+      }
+      mg /= T(C);
+      mgy /= T(C);
+      for (int64_t j = 0; j < C; ++j) gx[r * C + j] += inv[r] * (gr[j] - mg - yr[j] * mgy);
+    }
+  });
   return out;
 }
 
-#define AG_INSTANTIATE(T)                                   \
-  template Tensor<T> channel_norm<T>(const Tensor<T>&, T);  \
+#define AG_INSTANTIATE(T)                                  \
+  template Tensor<T> channel_norm<T>(const Tensor<T>&, T); \
   template Tensor<T> layer_norm<T>(const Tensor<T>&, T);
 AG_INSTANTIATE(float)
 AG_INSTANTIATE(double)

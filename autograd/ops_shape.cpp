@@ -15,8 +15,7 @@ template <class T> Tensor<T> concat_cols(const std::vector<Tensor<T>>& xs) {
   for (const auto& x : xs) {
     check_2d("concat_cols", x.shape());
     if (x.rows() != R)
-      throw Error("concat_cols: row counts differ, " + shape_str(xs[0].shape()) + " vs " +
-                  shape_str(x.shape()));
+      throw Error("concat_cols: row counts differ, " + shape_str(xs[0].shape()) + " vs " + shape_str(x.shape()));
     off.push_back(off.back() + x.cols());
   }
   const int64_t C = off.back();
@@ -59,8 +58,7 @@ template <class T> Tensor<T> concat_rows(const std::vector<Tensor<T>>& xs) {
   for (const auto& x : xs) {
     check_2d("concat_rows", x.shape());
     if (x.cols() != C)
-      throw Error("concat_rows: column counts differ, " + shape_str(xs[0].shape()) + " vs " +
-                  shape_str(x.shape()));
+      throw Error("concat_rows: column counts differ, " + shape_str(xs[0].shape()) + " vs " + shape_str(x.shape()));
     off.push_back(off.back() + x.numel());
   }
   int64_t R = 0;
@@ -118,8 +116,8 @@ template <class T> Tensor<T> slice_rows(const Tensor<T>& x, int64_t begin, int64
   check_2d("slice_rows", x.shape());
   const int64_t R = x.rows(), C = x.cols();
   if (begin < 0 || end < begin || end > R)
-    throw Error("slice_rows: range [" + std::to_string(begin) + ", " + std::to_string(end) +
-                ") outside the rows of " + shape_str(x.shape()));
+    throw Error("slice_rows: range [" + std::to_string(begin) + ", " + std::to_string(end) + ") outside the rows of " +
+                shape_str(x.shape()));
   auto out = new_output<T>({end - begin, C});
   std::copy(x.data() + begin * C, x.data() + end * C, out.data());
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), begin, C] {
@@ -136,8 +134,7 @@ template <class T> Tensor<T> slice_rows(const Tensor<T>& x, int64_t begin, int64
 // ---- reshape ------------------------------------------------------------------------------------
 template <class T> Tensor<T> reshape(const Tensor<T>& x, const Shape& shape) {
   if (numel_of(shape) != x.numel())
-    throw Error("reshape: element counts differ, " + shape_str(x.shape()) + " vs " +
-                shape_str(shape));
+    throw Error("reshape: element counts differ, " + shape_str(x.shape()) + " vs " + shape_str(shape));
   auto out = Tensor<T>::from(shape, x.values());
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node()] {
     if (!xn->requires_grad) return;
@@ -148,11 +145,11 @@ template <class T> Tensor<T> reshape(const Tensor<T>& x, const Shape& shape) {
   return out;
 }
 
-#define AG_INSTANTIATE(T)                                                              \
-  template Tensor<T> concat_cols<T>(const std::vector<Tensor<T>>&);                    \
-  template Tensor<T> concat_rows<T>(const std::vector<Tensor<T>>&);                    \
-  template Tensor<T> slice_cols<T>(const Tensor<T>&, int64_t, int64_t);                \
-  template Tensor<T> slice_rows<T>(const Tensor<T>&, int64_t, int64_t);                \
+#define AG_INSTANTIATE(T)                                               \
+  template Tensor<T> concat_cols<T>(const std::vector<Tensor<T>>&);     \
+  template Tensor<T> concat_rows<T>(const std::vector<Tensor<T>>&);     \
+  template Tensor<T> slice_cols<T>(const Tensor<T>&, int64_t, int64_t); \
+  template Tensor<T> slice_rows<T>(const Tensor<T>&, int64_t, int64_t); \
   template Tensor<T> reshape<T>(const Tensor<T>&, const Shape&);
 AG_INSTANTIATE(float)
 AG_INSTANTIATE(double)

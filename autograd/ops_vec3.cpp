@@ -19,20 +19,19 @@ template <class T> Tensor<T> dot_rows(const Tensor<T>& a, const Tensor<T>& b) {
     for (int64_t j = 0; j < C; ++j) s += pa[r * C + j] * pb[r * C + j];
     o[r] = s;
   }
-  record(out.node(), {a.node_ptr(), b.node_ptr()},
-         [an = &a.node(), bn = &b.node(), on = &out.node(), R, C] {
-           const T* g = on->grad.data();
-           // d/da = g b, d/db = g a
-           for (auto [xn, yn] : {std::pair{an, bn}, std::pair{bn, an}}) {
-             if (!xn->requires_grad) continue;
-             xn->ensure_grad();
-             T* gx = xn->grad.data();
-             const T* y = yn->value.data();
+  record(out.node(), {a.node_ptr(), b.node_ptr()}, [an = &a.node(), bn = &b.node(), on = &out.node(), R, C] {
+    const T* g = on->grad.data();
+    // d/da = g b, d/db = g a
+    for (auto [xn, yn] : {std::pair{an, bn}, std::pair{bn, an}}) {
+      if (!xn->requires_grad) continue;
+      xn->ensure_grad();
+      T* gx = xn->grad.data();
+      const T* y = yn->value.data();
 #pragma omp parallel for if (R * C > kParallelMin)
-             for (int64_t r = 0; r < R; ++r)
-               for (int64_t j = 0; j < C; ++j) gx[r * C + j] += g[r] * y[r * C + j];
-           }
-         });
+      for (int64_t r = 0; r < R; ++r)
+        for (int64_t j = 0; j < C; ++j) gx[r * C + j] += g[r] * y[r * C + j];
+    }
+  });
   return out;
 }
 
@@ -55,25 +54,24 @@ template <class T> Tensor<T> cross3(const Tensor<T>& a, const Tensor<T>& b) {
   T* o = out.data();
 #pragma omp parallel for if (R * 3 > kParallelMin)
   for (int64_t r = 0; r < R; ++r) cross_add(pa + 3 * r, pb + 3 * r, o + 3 * r);
-  record(out.node(), {a.node_ptr(), b.node_ptr()},
-         [an = &a.node(), bn = &b.node(), on = &out.node(), R] {
-           const T* g = on->grad.data();
-           // L = g . (a x b): dL/da = b x g, dL/db = g x a.
-           if (an->requires_grad) {
-             an->ensure_grad();
-             const T* pb = bn->value.data();
-             T* ga = an->grad.data();
+  record(out.node(), {a.node_ptr(), b.node_ptr()}, [an = &a.node(), bn = &b.node(), on = &out.node(), R] {
+    const T* g = on->grad.data();
+    // L = g . (a x b): dL/da = b x g, dL/db = g x a.
+    if (an->requires_grad) {
+      an->ensure_grad();
+      const T* pb = bn->value.data();
+      T* ga = an->grad.data();
 #pragma omp parallel for if (R * 3 > kParallelMin)
-             for (int64_t r = 0; r < R; ++r) cross_add(pb + 3 * r, g + 3 * r, ga + 3 * r);
-           }
-           if (bn->requires_grad) {
-             bn->ensure_grad();
-             const T* pa = an->value.data();
-             T* gb = bn->grad.data();
+      for (int64_t r = 0; r < R; ++r) cross_add(pb + 3 * r, g + 3 * r, ga + 3 * r);
+    }
+    if (bn->requires_grad) {
+      bn->ensure_grad();
+      const T* pa = an->value.data();
+      T* gb = bn->grad.data();
 #pragma omp parallel for if (R * 3 > kParallelMin)
-             for (int64_t r = 0; r < R; ++r) cross_add(g + 3 * r, pa + 3 * r, gb + 3 * r);
-           }
-         });
+      for (int64_t r = 0; r < R; ++r) cross_add(g + 3 * r, pa + 3 * r, gb + 3 * r);
+    }
+  });
   return out;
 }
 
@@ -132,34 +130,33 @@ template <class T> Tensor<T> normalize_rows(const Tensor<T>& x, T eps) {
     const T d = std::max(nrm[r], eps);
     for (int64_t j = 0; j < C; ++j) o[r * C + j] = px[r * C + j] / d;
   }
-  record(out.node(), {x.node_ptr()},
-         [xn = &x.node(), on = &out.node(), nrm = std::move(nrm), eps, R, C] {
-           if (!xn->requires_grad) return;
-           xn->ensure_grad();
-           const T* g = on->grad.data();
-           const T* y = on->value.data();
-           T* gx = xn->grad.data();
+  record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), nrm = std::move(nrm), eps, R, C] {
+    if (!xn->requires_grad) return;
+    xn->ensure_grad();
+    const T* g = on->grad.data();
+    const T* y = on->value.data();
+    T* gx = xn->grad.data();
 #pragma omp parallel for if (R * C > kParallelMin)
-           for (int64_t r = 0; r < R; ++r) {
-             const T* gr = g + r * C;
-             T* gxr = gx + r * C;
-             if (nrm[r] > eps) {  // y = x/|x|: dx = (g - y (y.g)) / |x|
-               const T* yr = y + r * C;
-               T yg = 0;
-               for (int64_t j = 0; j < C; ++j) yg += yr[j] * gr[j];
-               for (int64_t j = 0; j < C; ++j) gxr[j] += (gr[j] - yr[j] * yg) / nrm[r];
-             } else {  // y = x/eps
-               for (int64_t j = 0; j < C; ++j) gxr[j] += gr[j] / eps;
-             }
-           }
-         });
+    for (int64_t r = 0; r < R; ++r) {
+      const T* gr = g + r * C;
+      T* gxr = gx + r * C;
+      if (nrm[r] > eps) {  // y = x/|x|: dx = (g - y (y.g)) / |x|
+        const T* yr = y + r * C;
+        T yg = 0;
+        for (int64_t j = 0; j < C; ++j) yg += yr[j] * gr[j];
+        for (int64_t j = 0; j < C; ++j) gxr[j] += (gr[j] - yr[j] * yg) / nrm[r];
+      } else {  // y = x/eps
+        for (int64_t j = 0; j < C; ++j) gxr[j] += gr[j] / eps;
+      }
+    }
+  });
   return out;
 }
 
-#define AG_INSTANTIATE(T)                                                 \
-  template Tensor<T> dot_rows<T>(const Tensor<T>&, const Tensor<T>&);     \
-  template Tensor<T> cross3<T>(const Tensor<T>&, const Tensor<T>&);       \
-  template Tensor<T> norm_rows<T>(const Tensor<T>&);                      \
+#define AG_INSTANTIATE(T)                                             \
+  template Tensor<T> dot_rows<T>(const Tensor<T>&, const Tensor<T>&); \
+  template Tensor<T> cross3<T>(const Tensor<T>&, const Tensor<T>&);   \
+  template Tensor<T> norm_rows<T>(const Tensor<T>&);                  \
   template Tensor<T> normalize_rows<T>(const Tensor<T>&, T);
 AG_INSTANTIATE(float)
 AG_INSTANTIATE(double)

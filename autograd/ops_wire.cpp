@@ -4,8 +4,7 @@
 
 namespace ag {
 
-template <class R>
-Tensor<std::complex<R>> wire(const Tensor<std::complex<R>>& x, R omega0, R s0) {
+template <class R> Tensor<std::complex<R>> wire(const Tensor<std::complex<R>>& x, R omega0, R s0) {
   using C = std::complex<R>;
   auto out = new_output<C>(x.shape());
   const int64_t n = x.numel();

@@ -14,7 +14,6 @@
 
 namespace ag {
 
-template <class R>
-Tensor<std::complex<R>> wire(const Tensor<std::complex<R>>& x, R omega0 = R(5), R s0 = R(10));
+template <class R> Tensor<std::complex<R>> wire(const Tensor<std::complex<R>>& x, R omega0 = R(5), R s0 = R(10));
 
 }  // namespace ag

@@ -23,13 +23,11 @@ int64_t numel_of(const Shape& s) {
 }
 
 void check_same_shape(const char* op, const Shape& a, const Shape& b) {
-  if (a != b)
-    throw Error(std::string(op) + ": shapes differ, " + shape_str(a) + " vs " + shape_str(b));
+  if (a != b) throw Error(std::string(op) + ": shapes differ, " + shape_str(a) + " vs " + shape_str(b));
 }
 
 void check_2d(const char* op, const Shape& a) {
-  if (a.size() != 2)
-    throw Error(std::string(op) + ": needs a 2-D tensor (rows x cols), got " + shape_str(a));
+  if (a.size() != 2) throw Error(std::string(op) + ": needs a 2-D tensor (rows x cols), got " + shape_str(a));
 }
 
 // ---- grad mode --------------------------------------------------------------------------
@@ -40,8 +38,7 @@ bool grad_enabled() { return g_grad_enabled; }
 NoGradGuard::NoGradGuard() : previous_(g_grad_enabled) { g_grad_enabled = false; }
 NoGradGuard::~NoGradGuard() { g_grad_enabled = previous_; }
 
-void record(NodeBase& out, std::vector<std::shared_ptr<NodeBase>> parents,
-            std::function<void()> fn) {
+void record(NodeBase& out, std::vector<std::shared_ptr<NodeBase>> parents, std::function<void()> fn) {
   if (!g_grad_enabled) return;
   bool any = false;
   for (const auto& p : parents) any = any || (p && p->requires_grad);
@@ -108,11 +105,9 @@ template <class T> Tensor<T> Tensor<T>::full(const Shape& shape, T v, bool requi
   return Tensor<T>(std::move(n));
 }
 
-template <class T>
-Tensor<T> Tensor<T>::from(const Shape& shape, std::vector<T> values, bool requires_grad) {
+template <class T> Tensor<T> Tensor<T>::from(const Shape& shape, std::vector<T> values, bool requires_grad) {
   if (static_cast<int64_t>(values.size()) != numel_of(shape))
-    throw Error("Tensor::from: " + std::to_string(values.size()) + " values for shape " +
-                shape_str(shape));
+    throw Error("Tensor::from: " + std::to_string(values.size()) + " values for shape " + shape_str(shape));
   auto n = std::make_shared<Node<T>>();
   n->shape = shape;
   n->value = std::move(values);
@@ -164,9 +159,7 @@ template <class T> Tensor<T>& Tensor<T>::set_requires_grad(bool on) {
   return *this;
 }
 
-template <class T> Tensor<T> Tensor<T>::detach() const {
-  return from(shape(), values(), false);
-}
+template <class T> Tensor<T> Tensor<T>::detach() const { return from(shape(), values(), false); }
 
 template class Tensor<float>;
 template class Tensor<double>;

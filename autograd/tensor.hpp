@@ -43,8 +43,7 @@ template <class T> struct real_of { using type = T; };
 template <class T> struct real_of<std::complex<T>> { using type = T; };
 template <class T> using real_t = typename real_of<T>::type;
 
-template <class T>
-using RowMat = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+template <class T> using RowMat = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 template <class T> using MatMap = Eigen::Map<RowMat<T>>;
 template <class T> using ConstMatMap = Eigen::Map<const RowMat<T>>;
 
@@ -104,8 +103,7 @@ template <class T> class Tensor {
   static Tensor from(const Shape& shape, std::vector<T> values, bool requires_grad = false);
   static Tensor scalar(T v, bool requires_grad = false) { return full({1, 1}, v, requires_grad); }
   // A 2-D tensor copied from an Eigen matrix expression (any storage order).
-  template <class Derived>
-  static Tensor from_eigen(const Eigen::MatrixBase<Derived>& m, bool requires_grad = false) {
+  template <class Derived> static Tensor from_eigen(const Eigen::MatrixBase<Derived>& m, bool requires_grad = false) {
     Tensor t = zeros({m.rows(), m.cols()}, requires_grad);
     t.mat() = m;
     return t;
@@ -166,8 +164,7 @@ template <class T> Tensor<T> new_output(const Shape& shape) { return Tensor<T>::
 // Attach history to an op's output: if grad mode is on and any parent requires grad, the
 // output requires grad, keeps its parents alive and stores `fn` as its backward. `fn`
 // should capture raw Node pointers (parents are kept alive by `parents`).
-void record(NodeBase& out, std::vector<std::shared_ptr<NodeBase>> parents,
-            std::function<void()> fn);
+void record(NodeBase& out, std::vector<std::shared_ptr<NodeBase>> parents, std::function<void()> fn);
 
 // Rows processed per OpenMP chunk are large enough to amortise thread start-up.
 inline constexpr int64_t kParallelMin = 16384;

@@ -2,8 +2,8 @@
 // the surface, and far points), the max_distance knob (time vs fraction of points left
 // without an answer), ray casts, per-frame update + commit (rebuild vs refit, and the query
 // speed each leaves behind), and load_body_sequence seconds per frame.
-#include "gdsr/body.hpp"
-#include "gdsr/body_query.hpp"
+#include "gdsr/body/body.hpp"
+#include "gdsr/body/body_query.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -53,7 +53,8 @@ void BM_ClosestNear(benchmark::State& st) {
   const Points3 P = near_points(m, static_cast<int>(st.range(0)), 1);
   for (auto _ : st) benchmark::DoNotOptimize(q.closest(P));
   st.SetItemsProcessed(st.iterations() * P.rows());
-  st.counters["points_per_s"] = benchmark::Counter(static_cast<double>(st.iterations() * P.rows()), benchmark::Counter::kIsRate);
+  st.counters["points_per_s"] =
+      benchmark::Counter(static_cast<double>(st.iterations() * P.rows()), benchmark::Counter::kIsRate);
   st.counters["triangles"] = static_cast<double>(m.F.rows());
 }
 BENCHMARK(BM_ClosestNear)->Arg(1000)->Arg(15000)->UseRealTime()->Unit(benchmark::kMicrosecond);
@@ -63,7 +64,8 @@ void BM_ClosestFar(benchmark::State& st) {
   const BodyQuery q(m);
   const Points3 P = far_points(m, static_cast<int>(st.range(0)), 2);
   for (auto _ : st) benchmark::DoNotOptimize(q.closest(P));
-  st.counters["points_per_s"] = benchmark::Counter(static_cast<double>(st.iterations() * P.rows()), benchmark::Counter::kIsRate);
+  st.counters["points_per_s"] =
+      benchmark::Counter(static_cast<double>(st.iterations() * P.rows()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_ClosestFar)->Arg(1000)->Arg(15000)->UseRealTime()->Unit(benchmark::kMicrosecond);
 
@@ -78,7 +80,8 @@ void BM_ClosestMaxDistance(benchmark::State& st) {
     const ClosestPoints c = q.closest(P, true, r);
     missed = (c.face.array() < 0).cast<double>().mean();
   }
-  st.counters["points_per_s"] = benchmark::Counter(static_cast<double>(st.iterations() * P.rows()), benchmark::Counter::kIsRate);
+  st.counters["points_per_s"] =
+      benchmark::Counter(static_cast<double>(st.iterations() * P.rows()), benchmark::Counter::kIsRate);
   st.counters["missed_fraction"] = missed;
 }
 BENCHMARK(BM_ClosestMaxDistance)->Arg(2)->Arg(5)->Arg(10)->UseRealTime()->Unit(benchmark::kMicrosecond);
@@ -93,7 +96,8 @@ void BM_Rays(benchmark::State& st) {
     const RayHits h = q.intersect(O, D);
     hit = (h.face.array() >= 0).cast<double>().mean();
   }
-  st.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(st.iterations() * O.rows()), benchmark::Counter::kIsRate);
+  st.counters["rays_per_s"] =
+      benchmark::Counter(static_cast<double>(st.iterations() * O.rows()), benchmark::Counter::kIsRate);
   st.counters["hit_fraction"] = hit;
 }
 BENCHMARK(BM_Rays)->Arg(15000)->UseRealTime()->Unit(benchmark::kMicrosecond);
@@ -120,7 +124,8 @@ void BM_ClosestAfterUpdates(benchmark::State& st) {
   for (int t = 1; t <= last; ++t) q.update(s.frames[t]);
   const Points3 P = near_points(s.frame_mesh(last), 15000, 6);
   for (auto _ : st) benchmark::DoNotOptimize(q.closest(P));
-  st.counters["points_per_s"] = benchmark::Counter(static_cast<double>(st.iterations() * P.rows()), benchmark::Counter::kIsRate);
+  st.counters["points_per_s"] =
+      benchmark::Counter(static_cast<double>(st.iterations() * P.rows()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_ClosestAfterUpdates)->Arg(0)->Arg(1)->UseRealTime()->Unit(benchmark::kMicrosecond);
 

@@ -1,16 +1,19 @@
 // Cloth solver speed vs accuracy: skirt_short on the first second of CMU 01_01 (falls back
 // to an analytic swaying mannequin without the file) at LR (30 mm) and HR (10 mm), for
-// several substep counts. Counters next to the time: seconds per frame, vertices, the
-// paper's stretch/shear energies (mean over frames), max body penetration, mean curvature
-// (wrinkle measure, 1/m) and the RMS position error at the last frame against a
-// reference run with 80 substeps (metres).
+// several substep / iteration settings, with and without self-collision. Counters next to
+// the time: seconds per frame, vertices, the paper's stretch/shear energies (mean over
+// frames), max body penetration, mean curvature (wrinkle measure, 1/m), self-intersecting
+// non-adjacent triangle pairs counted by CGAL (mean over every 4th frame, and the fraction
+// of those frames that are clean) and the RMS position error at the last frame against a
+// reference run with 40 substeps x 4 passes (metres).
 #include <benchmark/benchmark.h>
 
-#include "gdsr/body.hpp"
-#include "sim/cloth_bodies.hpp"
-#include "sim/cloth_solver.hpp"
-#include "sim/garments.hpp"
-#include "sim/sim_metrics.hpp"
+#include "gdsr/body/body.hpp"
+#include "tests/support/cloth_bodies.hpp"
+#include "gdsr/sim/cloth_solver.hpp"
+#include "gdsr/sim/garments.hpp"
+#include "gdsr/geometry/self_intersections.hpp"
+#include "gdsr/sim/sim_metrics.hpp"
 
 #include <chrono>
 #include <ctime>
@@ -61,9 +64,11 @@ const sim::Garment& garment(int mm) {
   return it->second;
 }
 
-std::vector<gdsr::Points3> run(int mm, int substeps) {
+std::vector<gdsr::Points3> run(int mm, int substeps, int iterations, bool self_collision) {
   sim::SimParams p;
   p.substeps = substeps;
+  p.iterations = iterations;
+  p.self_collision = self_collision;
   p.settle_frames = 0;
   return sim::simulate_frames(garment(mm), scene().F, scene().frames, scene().fps, p);
 }
@@ -71,13 +76,15 @@ std::vector<gdsr::Points3> run(int mm, int substeps) {
 const gdsr::Points3& reference(int mm) {
   static std::map<int, gdsr::Points3> cache;
   auto it = cache.find(mm);
-  if (it == cache.end()) it = cache.emplace(mm, run(mm, 80).back()).first;
+  if (it == cache.end()) it = cache.emplace(mm, run(mm, 40, 4, true).back()).first;
   return it->second;
 }
 
 void BM_ClothSkirtShort(benchmark::State& state) {
   const int mm = static_cast<int>(state.range(0));
   const int substeps = static_cast<int>(state.range(1));
+  const int iterations = static_cast<int>(state.range(2));
+  const bool self_collision = state.range(3) != 0;
   const auto& sc = scene();
   const auto& g = garment(mm);
   const auto& ref = reference(mm);
@@ -86,7 +93,7 @@ void BM_ClothSkirtShort(benchmark::State& state) {
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::clock_t c0 = std::clock();
-    out = run(mm, substeps);
+    out = run(mm, substeps, iterations, self_collision);
     cpu += static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
@@ -109,14 +116,29 @@ void BM_ClothSkirtShort(benchmark::State& state) {
   state.counters["pen_max_m"] = pen;
   state.counters["curvature"] = m.back().wrinkles.mean_curvature;
   state.counters["dihedral"] = m.back().wrinkles.mean_dihedral;
-  state.counters["rms_vs_80sub_m"] = std::sqrt((out.back() - ref).rowwise().squaredNorm().mean());
+  double isect = 0;
+  int checked = 0, clean = 0;
+  for (size_t t = 0; t < out.size(); t += 4, ++checked) {
+    const auto n = gdsr::self_intersections(out[t], g.mesh.F).pairs;
+    isect += static_cast<double>(n);
+    clean += n == 0;
+  }
+  state.counters["isect_pairs"] = isect / checked;
+  state.counters["clean_frac"] = static_cast<double>(clean) / checked;
+  state.counters["rms_vs_ref_m"] = std::sqrt((out.back() - ref).rowwise().squaredNorm().mean());
 }
 
 }  // namespace
 
 BENCHMARK(BM_ClothSkirtShort)
-    ->ArgsProduct({{30, 10}, {5, 10, 20, 40}})
-    ->ArgNames({"mm", "substeps"})
+    ->Args({30, 40, 1, 0})  // the former default: no self-collision, one pass
+    ->Args({30, 20, 2, 1})  // the default
+    ->Args({30, 10, 2, 1})
+    ->Args({30, 20, 4, 1})
+    ->Args({10, 40, 1, 0})
+    ->Args({10, 20, 2, 1})
+    ->Args({10, 10, 2, 1})
+    ->ArgNames({"mm", "substeps", "iterations", "self"})
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
 

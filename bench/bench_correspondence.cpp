@@ -2,8 +2,8 @@
 // apply (upsample / downsample per frame) and the UV raster, with the interpolation error
 // of an affine field next to the time (must be ~1e-15: any barycentric map reproduces it).
 // Meshes: a seamed tube pattern at LR particle distance ~ 3x the HR one, like 30 mm / 10 mm.
-#include "gdsr/correspondence.hpp"
-#include "gdsr/uv_raster.hpp"
+#include "gdsr/geometry/correspondence.hpp"
+#include "gdsr/geometry/uv_raster.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -4,13 +4,21 @@
 // 80 x 80 pixels of a 1024 raster, L1 on C_hat and G, backward), per preset.
 // Counters: share of each block in the forward (features, H, E, A, field), the model's
 // GFLOP per call (multiply-adds x 2 of its linear maps, from the architecture) and GFLOP/s.
+// Float32 vs float64 inference (same weights): s/frame of each and the largest difference
+// of the HR output G in mm. A dense Eigen GEMM is timed in the same run as the yardstick for
+// a loaded machine (compare GFLOP/s ratios, not seconds). The program runs with passive
+// OpenMP waiting unless OMP_WAIT_POLICY is set, and with large blocks kept in the heap
+// (autograd/runtime.hpp).
 #include <benchmark/benchmark.h>
 
 #include "autograd/autograd.hpp"
-#include "gdsr/correspondence.hpp"
-#include "gdsr/gdsr_model.hpp"
-#include "gdsr/model_config.hpp"
-#include "gdsr/model_geometry.hpp"
+#include "autograd/gemm_blocks.hpp"
+#include "autograd/runtime.hpp"
+#include "gdsr/geometry/correspondence.hpp"
+#include "gdsr/model/gdsr_model.hpp"
+#include "gdsr/model/model_config.hpp"
+#include "gdsr/model/frames.hpp"
+#include "tests/support/grid_garment.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -22,27 +30,10 @@ using namespace gdsr;
 
 namespace {
 
+// The tests' grid in the x-z plane with a smooth bump (metres).
 GarmentMesh grid(int n, double size) {
-  GarmentMesh g;
-  g.V.resize(n * n, 3);
-  g.UV.resize(n * n, 2);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      const int v = i * n + j;
-      const double x = size * j / (n - 1), z = size * i / (n - 1);
-      g.V.row(v) << x, 0.02 * std::sin(9 * x) * std::cos(7 * z), z;
-      g.UV.row(v) << x, z;
-      g.uv_to_vertex.push_back(v);
-    }
-  g.F.resize(2 * (n - 1) * (n - 1), 3);
-  int f = 0;
-  for (int i = 0; i + 1 < n; ++i)
-    for (int j = 0; j + 1 < n; ++j) {
-      const int a = i * n + j, b = a + 1, c = a + n, d = c + 1;
-      g.F.row(f++) << a, c, b;
-      g.F.row(f++) << b, c, d;
-    }
-  g.FUV = g.F;
+  GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec::square(n, size));
+  for (int v = 0; v < g.V.rows(); ++v) g.V(v, 1) = 0.02 * std::sin(9 * g.V(v, 0)) * std::cos(7 * g.V(v, 2));
   return g;
 }
 
@@ -102,11 +93,11 @@ Flops model_flops(const ModelConfig& c, const GarmentGraph& g, int64_t faces_nee
   const int64_t V = g.num_vertices, E1 = g.ring1_size(), E2 = g.ring2_size(), L = c.latent();
   const int64_t mid = c.node_encoder_pre.back();
   Flops f;
-  f.h = double(V) * (stack_macs(c.node_encoder_pre) + mid * mid + stack_macs(c.node_encoder_post) +
-                     stack_macs(c.decoder)) +
+  f.h = double(V) *
+            (stack_macs(c.node_encoder_pre) + mid * mid + stack_macs(c.node_encoder_post) + stack_macs(c.decoder)) +
         double(E1) * stack_macs(c.edge_encoder) +
-        double(c.mp_steps) * (double(E1 + E2) * block_macs(3 * L, L) +
-                              double(V) * block_macs((c.layer_edge_mlps ? 4 : 3) * L, L));
+        double(c.mp_steps) *
+            (double(E1 + E2) * block_macs(3 * L, L) + double(V) * block_macs((c.layer_edge_mlps ? 4 : 3) * L, L));
   f.e = double(g.num_faces()) * (stack_macs(c.e_widths) + c.e_widths.back() * 9);
   f.a = double(faces_needed) * (stack_macs(c.a_widths) + 2 * c.a_widths.back() * c.field_params());
   double per_sample = 0;
@@ -164,6 +155,62 @@ void BM_Inference(benchmark::State& st, const std::string& preset) {
   st.counters["HR_vertices"] = s.all.size();
 }
 
+// Float64 twin of the float32 model (same weights), and the largest |G32 - G64| in mm.
+GDSR<double>& model64(const std::string& preset, double* max_diff_mm) {
+  static std::map<std::string, std::pair<std::shared_ptr<GDSR<double>>, double>> m;
+  auto& e = m[preset];
+  if (!e.first) {
+    GDSR<float>& m32 = model(preset);
+    e.first = std::make_shared<GDSR<double>>(m32.config());
+    nn::copy_parameters(m32, *e.first);
+    const Scene& s = scene();
+    ag::NoGradGuard ng;
+    const auto a = m32.forward(s.graph, s.in, &s.all, nullptr, nullptr);
+    const auto b = e.first->forward(s.graph, s.in, &s.all, nullptr, nullptr);
+    double d = 0;
+    for (int64_t i = 0; i < a.G.numel(); ++i) d = std::max(d, std::abs(double(a.G.data()[i]) - b.G.data()[i]));
+    e.second = 1e3 * d;
+  }
+  *max_diff_mm = e.second;
+  return *e.first;
+}
+
+void BM_Inference64(benchmark::State& st, const std::string& preset) {
+  const Scene& s = scene();
+  double diff_mm = 0;
+  GDSR<double>& m = model64(preset, &diff_mm);
+  GdsrTimings t;
+  int iters = 0;
+  double secs = 0;
+  for (auto _ : st) {
+    ag::NoGradGuard ng;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto out = m.forward(s.graph, s.in, &s.all, nullptr, &t);
+    benchmark::DoNotOptimize(out.G.data());
+    secs += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ++iters;
+  }
+  const Flops f = model_flops(m.config(), s.graph, s.graph.num_faces(), s.all.size());
+  set_counters(st, t, iters, f, secs / iters);
+  st.counters["max_diff_f32_mm"] = diff_mm;
+}
+
+// Yardstick: one dense float32 GEMM (2048 x 512 x 4096, 8.6 GFLOP), threaded as the model's
+// GEMMs are (row blocks over OpenMP, autograd/gemm_blocks.hpp).
+void BM_DenseGemmReference(benchmark::State& st) {
+  using M = ag::RowMat<float>;
+  const M a = M::Random(2048, 512), b = M::Random(4096, 512);
+  M c(2048, 4096);
+  for (auto _ : st) {
+    ag::gemm::row_blocks(a.rows(), a.cols() * b.rows(), [&](int64_t r0, int64_t r1) {
+      c.middleRows(r0, r1 - r0).noalias() = a.middleRows(r0, r1 - r0) * b.transpose();
+    });
+    benchmark::DoNotOptimize(c.data());
+  }
+  st.counters["GFLOP/s"] =
+      benchmark::Counter(2.0 * 2048 * 512 * 4096 * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+}
+
 void BM_TrainStep(benchmark::State& st, const std::string& preset) {
   const Scene& s = scene();
   GDSR<float>& m = model(preset);
@@ -200,8 +247,27 @@ void BM_TrainStep(benchmark::State& st, const std::string& preset) {
 
 BENCHMARK_CAPTURE(BM_Inference, tiny, std::string("tiny"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Inference, small, std::string("small"))->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Inference, paper, std::string("paper"))->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK_CAPTURE(BM_Inference, paper, std::string("paper"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+BENCHMARK_CAPTURE(BM_Inference64, paper, std::string("paper"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+BENCHMARK(BM_DenseGemmReference)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_TrainStep, small, std::string("small"))->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_TrainStep, paper, std::string("paper"))->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK_CAPTURE(BM_TrainStep, paper, std::string("paper"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  ag::configure_runtime(argv);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::AddCustomContext("omp_wait_policy", ag::openmp_wait_policy());
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -56,7 +56,8 @@ BENCHMARK(BM_VggLossBackward)->Arg(80)->Arg(224)->Unit(benchmark::kMillisecond);
 void BM_Conv64(benchmark::State& st) {
   const int64_t s = st.range(0);
   nn::Rng rng(4);
-  ag::Tensorf x = ag::Tensorf::zeros({1, 64, s, s}), w = ag::Tensorf::zeros({64, 64, 3, 3}), b = ag::Tensorf::zeros({64});
+  ag::Tensorf x = ag::Tensorf::zeros({1, 64, s, s}), w = ag::Tensorf::zeros({64, 64, 3, 3}),
+              b = ag::Tensorf::zeros({64});
   for (auto& v : x.values()) v = static_cast<float>(rng.normal(0, 1));
   for (auto& v : w.values()) v = static_cast<float>(rng.normal(0, 0.05));
   ag::NoGradGuard ng;

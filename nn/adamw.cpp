@@ -31,12 +31,10 @@ template <class R> RealView<R> view(typename AdamW<R>::Slot& s) {
 }
 }  // namespace
 
-template <class R> int64_t AdamW<R>::Slot::reals() const {
-  return (complex ? 2 : 1) * node->numel();
-}
+template <class R> int64_t AdamW<R>::Slot::reals() const { return (complex ? 2 : 1) * node->numel(); }
 
-template <class R>
-AdamW<R>::AdamW(const std::vector<std::pair<std::string, ag::Tensor<R>>>& params, AdamWOptions opt) : opt_(opt) {
+template <class R> AdamW<R>::AdamW(const std::vector<std::pair<std::string, ag::Tensor<R>>>& params, AdamWOptions opt)
+    : opt_(opt) {
   add_all(params);
 }
 

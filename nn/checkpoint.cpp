@@ -14,11 +14,16 @@ constexpr size_t kHeader = 8 + 4 + 4 + 8 + 8;
 
 size_t dtype_size(DType d) {
   switch (d) {
-    case DType::F32: return 4;
-    case DType::F64: return 8;
-    case DType::C64: return 8;
-    case DType::C128: return 16;
-    case DType::I64: return 8;
+    case DType::F32:
+      return 4;
+    case DType::F64:
+      return 8;
+    case DType::C64:
+      return 8;
+    case DType::C128:
+      return 16;
+    case DType::I64:
+      return 8;
   }
   return 0;
 }
@@ -66,11 +71,16 @@ struct Reader {
 
 std::string dtype_name(DType d) {
   switch (d) {
-    case DType::F32: return "float32";
-    case DType::F64: return "float64";
-    case DType::C64: return "complex64";
-    case DType::C128: return "complex128";
-    case DType::I64: return "int64";
+    case DType::F32:
+      return "float32";
+    case DType::F64:
+      return "float64";
+    case DType::C64:
+      return "complex64";
+    case DType::C128:
+      return "complex128";
+    case DType::I64:
+      return "int64";
   }
   return "unknown";
 }
@@ -188,7 +198,8 @@ Checkpoint read_checkpoint(const std::string& path) {
     throw ag::Error("checkpoint '" + path + "': truncated (payload " + std::to_string(have) + " of " +
                     std::to_string(payload_size) + " bytes)");
   if (have > payload_size)
-    throw ag::Error("checkpoint '" + path + "': " + std::to_string(have - payload_size) + " trailing bytes (corrupted)");
+    throw ag::Error("checkpoint '" + path + "': " + std::to_string(have - payload_size) +
+                    " trailing bytes (corrupted)");
   const uint8_t* pl = all.data() + kHeader;
   if (fnv1a64(pl, payload_size) != checksum)
     throw ag::Error("checkpoint '" + path + "': checksum mismatch (corrupted)");
@@ -219,9 +230,8 @@ Checkpoint read_checkpoint(const std::string& path) {
   return ck;
 }
 
-template <class T>
-void save_checkpoint(const std::string& path, const Module<T>& model, const AdamW<T>* opt, int64_t step,
-                     const std::string& metadata_json) {
+template <class T> void save_checkpoint(const std::string& path, const Module<T>& model, const AdamW<T>* opt,
+                                        int64_t step, const std::string& metadata_json) {
   Checkpoint ck;
   ck.step = step;
   ck.metadata = metadata_json;
@@ -299,8 +309,10 @@ template <class T> Checkpoint load_checkpoint(const std::string& path, Module<T>
   return ck;
 }
 
-template void save_checkpoint(const std::string&, const Module<float>&, const AdamW<float>*, int64_t, const std::string&);
-template void save_checkpoint(const std::string&, const Module<double>&, const AdamW<double>*, int64_t, const std::string&);
+template void save_checkpoint(const std::string&, const Module<float>&, const AdamW<float>*, int64_t,
+                              const std::string&);
+template void save_checkpoint(const std::string&, const Module<double>&, const AdamW<double>*, int64_t,
+                              const std::string&);
 template Checkpoint load_checkpoint(const std::string&, Module<float>&, AdamW<float>*);
 template Checkpoint load_checkpoint(const std::string&, Module<double>&, AdamW<double>*);
 

@@ -84,14 +84,12 @@ Checkpoint read_checkpoint(const std::string& path);
 uint64_t fnv1a64(const uint8_t* data, size_t n);
 
 // Model parameters (+ optimizer state if opt != nullptr) of a float or double model.
-template <class T>
-void save_checkpoint(const std::string& path, const Module<T>& model, const AdamW<T>* opt, int64_t step,
-                     const std::string& metadata_json = "{}");
+template <class T> void save_checkpoint(const std::string& path, const Module<T>& model, const AdamW<T>* opt,
+                                        int64_t step, const std::string& metadata_json = "{}");
 // Loads into an existing model (and optimizer). Every model parameter must be in the file
 // with the same dtype and shape and the file must hold no other parameters; with opt the
 // file must hold the optimizer state of exactly the optimizer's slots. Returns the file
 // (step, metadata, all entries).
-template <class T>
-Checkpoint load_checkpoint(const std::string& path, Module<T>& model, AdamW<T>* opt);
+template <class T> Checkpoint load_checkpoint(const std::string& path, Module<T>& model, AdamW<T>* opt);
 
 }  // namespace nn

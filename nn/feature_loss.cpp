@@ -13,8 +13,7 @@ namespace nn {
 // b / (na nb) where the norm is clamped (constant), and symmetrically for b.
 template <class T> ag::Tensor<T> cosine_distance_channels(const ag::Tensor<T>& a, const ag::Tensor<T>& b, T eps) {
   ag::check_same_shape("cosine_distance_channels", a.shape(), b.shape());
-  if (a.dim() != 4)
-    throw ag::Error("cosine_distance_channels: needs [N x C x H x W], got " + ag::shape_str(a.shape()));
+  if (a.dim() != 4) throw ag::Error("cosine_distance_channels: needs [N x C x H x W], got " + ag::shape_str(a.shape()));
   const int64_t N = a.size(0), C = a.size(1), HW = a.size(2) * a.size(3), P = N * HW;
   if (P == 0 || C == 0) throw ag::Error("cosine_distance_channels: empty input " + ag::shape_str(a.shape()));
   std::vector<T> cosv(static_cast<size_t>(P)), na(static_cast<size_t>(P)), nb(static_cast<size_t>(P));
@@ -65,9 +64,8 @@ template <class T> ag::Tensor<T> cosine_distance_channels(const ag::Tensor<T>& a
   return out;
 }
 
-template <class T>
-ag::Tensor<T> feature_loss(const std::vector<ag::Tensor<T>>& pred, const std::vector<ag::Tensor<T>>& target,
-                           FeatureLossKind kind) {
+template <class T> ag::Tensor<T> feature_loss(const std::vector<ag::Tensor<T>>& pred,
+                                              const std::vector<ag::Tensor<T>>& target, FeatureLossKind kind) {
   if (pred.size() != target.size() || pred.empty())
     throw ag::Error("feature_loss: " + std::to_string(pred.size()) + " predicted vs " + std::to_string(target.size()) +
                     " target layers");
@@ -80,9 +78,8 @@ ag::Tensor<T> feature_loss(const std::vector<ag::Tensor<T>>& pred, const std::ve
   return total;
 }
 
-template <class T>
-ag::Tensor<T> vgg_loss(const VGG19Features<T>& vgg, const ag::Tensor<T>& pred, const ag::Tensor<T>& target,
-                       FeatureLossKind kind) {
+template <class T> ag::Tensor<T> vgg_loss(const VGG19Features<T>& vgg, const ag::Tensor<T>& pred,
+                                          const ag::Tensor<T>& target, FeatureLossKind kind) {
   std::vector<ag::Tensor<T>> ft;
   if (target.requires_grad()) {
     ft = vgg.features(target);
@@ -93,7 +90,7 @@ ag::Tensor<T> vgg_loss(const VGG19Features<T>& vgg, const ag::Tensor<T>& pred, c
   return feature_loss(vgg.features(pred), ft, kind);
 }
 
-#define NN_FL_INST(T)                                                                                        \
+#define NN_FL_INST(T)                                                                                       \
   template ag::Tensor<T> cosine_distance_channels(const ag::Tensor<T>&, const ag::Tensor<T>&, T);           \
   template ag::Tensor<T> feature_loss(const std::vector<ag::Tensor<T>>&, const std::vector<ag::Tensor<T>>&, \
                                       FeatureLossKind);                                                     \

@@ -16,17 +16,17 @@ enum class FeatureLossKind {
 // a, b [N x C x H x W] -> [1 x 1]: 1 - mean over the N*H*W pixels of the cosine similarity
 // of the C-vectors, cos = a.b / (max(|a|, eps) max(|b|, eps)) (torch.nn.functional.
 // cosine_similarity). Gradients to a and b (either may be constant).
-template <class T> ag::Tensor<T> cosine_distance_channels(const ag::Tensor<T>& a, const ag::Tensor<T>& b, T eps = T(1e-8));
+template <class T>
+ag::Tensor<T> cosine_distance_channels(const ag::Tensor<T>& a, const ag::Tensor<T>& b, T eps = T(1e-8));
 
 // Sum over layers of the per-layer loss; pred and target hold matching feature maps.
-template <class T>
-ag::Tensor<T> feature_loss(const std::vector<ag::Tensor<T>>& pred, const std::vector<ag::Tensor<T>>& target,
-                           FeatureLossKind kind = FeatureLossKind::Cosine);
+template <class T> ag::Tensor<T> feature_loss(const std::vector<ag::Tensor<T>>& pred,
+                                              const std::vector<ag::Tensor<T>>& target,
+                                              FeatureLossKind kind = FeatureLossKind::Cosine);
 
 // VGG loss of two images [N x 3 x H x W] (RGB 0..1). Target features are computed without a
 // graph unless the target image requires grad.
-template <class T>
-ag::Tensor<T> vgg_loss(const VGG19Features<T>& vgg, const ag::Tensor<T>& pred, const ag::Tensor<T>& target,
-                       FeatureLossKind kind = FeatureLossKind::Cosine);
+template <class T> ag::Tensor<T> vgg_loss(const VGG19Features<T>& vgg, const ag::Tensor<T>& pred,
+                                          const ag::Tensor<T>& target, FeatureLossKind kind = FeatureLossKind::Cosine);
 
 }  // namespace nn

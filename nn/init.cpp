@@ -23,7 +23,8 @@ template <class R> struct Fill<std::complex<R>> {
 }  // namespace
 
 template <class T> void uniform_(ag::Tensor<T>& t, double lo, double hi, Rng& rng) {
-  if (!(lo <= hi)) throw ag::Error("nn::uniform_: empty range [" + std::to_string(lo) + ", " + std::to_string(hi) + ")");
+  if (!(lo <= hi))
+    throw ag::Error("nn::uniform_: empty range [" + std::to_string(lo) + ", " + std::to_string(hi) + ")");
   Fill<T>::run(t, [&] { return rng.uniform(lo, hi); });
 }
 
@@ -37,17 +38,16 @@ template <class T> void kaiming_uniform_(ag::Tensor<T>& t, int64_t fan_in, doubl
   uniform_(t, -bound, bound, rng);
 }
 
-template <class T>
-void xavier_uniform_(ag::Tensor<T>& t, int64_t fan_in, int64_t fan_out, Rng& rng, double gain) {
+template <class T> void xavier_uniform_(ag::Tensor<T>& t, int64_t fan_in, int64_t fan_out, Rng& rng, double gain) {
   if (fan_in + fan_out <= 0) throw ag::Error("nn::xavier_uniform_: fan_in + fan_out must be positive");
   const double bound = gain * std::sqrt(6.0 / static_cast<double>(fan_in + fan_out));
   uniform_(t, -bound, bound, rng);
 }
 
-#define NN_INIT_INST(T)                                                           \
-  template void uniform_(ag::Tensor<T>&, double, double, Rng&);                   \
-  template void normal_(ag::Tensor<T>&, double, double, Rng&);                    \
-  template void kaiming_uniform_(ag::Tensor<T>&, int64_t, double, Rng&);          \
+#define NN_INIT_INST(T)                                                  \
+  template void uniform_(ag::Tensor<T>&, double, double, Rng&);          \
+  template void normal_(ag::Tensor<T>&, double, double, Rng&);           \
+  template void kaiming_uniform_(ag::Tensor<T>&, int64_t, double, Rng&); \
   template void xavier_uniform_(ag::Tensor<T>&, int64_t, int64_t, Rng&, double);
 NN_INIT_INST(float)
 NN_INIT_INST(double)

@@ -17,7 +17,6 @@ template <class T> void normal_(ag::Tensor<T>& t, double mean, double std, Rng& 
 // bound = 1 / sqrt(fan_in).
 template <class T> void kaiming_uniform_(ag::Tensor<T>& t, int64_t fan_in, double a, Rng& rng);
 // torch.nn.init.xavier_uniform_: bound = gain * sqrt(6 / (fan_in + fan_out)).
-template <class T>
-void xavier_uniform_(ag::Tensor<T>& t, int64_t fan_in, int64_t fan_out, Rng& rng, double gain = 1.0);
+template <class T> void xavier_uniform_(ag::Tensor<T>& t, int64_t fan_in, int64_t fan_out, Rng& rng, double gain = 1.0);
 
 }  // namespace nn

@@ -9,7 +9,8 @@ namespace nn {
 
 template <class T> Linear<T>::Linear(int64_t in, int64_t out, bool use_bias, Rng& rng) : in_(in), out_(out) {
   if (in <= 0 || out <= 0)
-    throw ag::Error("nn::Linear: sizes must be positive, got in " + std::to_string(in) + ", out " + std::to_string(out));
+    throw ag::Error("nn::Linear: sizes must be positive, got in " + std::to_string(in) + ", out " +
+                    std::to_string(out));
   ag::Tensor<T> w = ag::Tensor<T>::zeros({out, in});
   kaiming_uniform_(w, in, std::sqrt(5.0), rng);
   weight = this->register_parameter("weight", w);

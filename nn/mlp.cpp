@@ -1,12 +1,12 @@
 #include "nn/mlp.hpp"
 
 #include "autograd/ops_elementwise.hpp"
+#include "autograd/ops_matmul.hpp"
 #include "autograd/ops_norm.hpp"
 
 namespace nn {
 
-template <class T>
-MLPBlock<T>::MLPBlock(int64_t in, int64_t out, bool norm, bool scale_shift, Rng& rng) : norm_(norm) {
+template <class T> MLPBlock<T>::MLPBlock(int64_t in, int64_t out, bool norm, bool scale_shift, Rng& rng) : norm_(norm) {
   linear1 = this->register_module("linear1", std::make_shared<Linear<T>>(in, out, true, rng));
   linear2 = this->register_module("linear2", std::make_shared<Linear<T>>(out, out, true, rng));
   if (scale_shift) {
@@ -17,15 +17,17 @@ MLPBlock<T>::MLPBlock(int64_t in, int64_t out, bool norm, bool scale_shift, Rng&
 
 template <class T> ag::Tensor<T> MLPBlock<T>::forward(const ag::Tensor<T>& x) const {
   const T slope = static_cast<T>(kSlope);
-  ag::Tensor<T> h = ag::leaky_relu(linear1->forward(x), slope);
+  // Bias and activation fused into the GEMMs' output pass where they follow directly.
+  ag::Tensor<T> h = ag::linear_leaky_relu(x, linear1->weight, linear1->bias, slope);
+  if (!norm_ && !scale.defined()) return ag::linear_leaky_relu(h, linear2->weight, linear2->bias, slope);
   h = linear2->forward(h);
   if (norm_) h = ag::channel_norm(h);
   if (scale.defined()) h = ag::add(ag::add(h, ag::mul(h, scale)), shift);  // h (1 + s) + b
   return ag::leaky_relu(h, slope);
 }
 
-template <class T>
-MLPStack<T>::MLPStack(const std::vector<int64_t>& widths, bool norm, bool scale_shift, Rng& rng) : widths_(widths) {
+template <class T> MLPStack<T>::MLPStack(const std::vector<int64_t>& widths, bool norm, bool scale_shift, Rng& rng)
+    : widths_(widths) {
   if (widths.size() < 2) throw ag::Error("nn::MLPStack: needs at least two widths (in and out)");
   for (size_t i = 0; i + 1 < widths.size(); ++i)
     blocks.push_back(this->register_module(

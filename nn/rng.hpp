@@ -27,9 +27,7 @@ class Rng {
     return r;
   }
   // Uniform in [lo, hi) with 53 random bits.
-  double uniform(double lo, double hi) {
-    return lo + (hi - lo) * (static_cast<double>(next() >> 11) * 0x1.0p-53);
-  }
+  double uniform(double lo, double hi) { return lo + (hi - lo) * (static_cast<double>(next() >> 11) * 0x1.0p-53); }
   // Gaussian (Box-Muller, both values used).
   double normal(double mean, double std) {
     if (has_spare_) {
@@ -37,7 +35,8 @@ class Rng {
       return mean + std * spare_;
     }
     double u1;
-    do u1 = uniform(0.0, 1.0); while (u1 <= 0.0);
+    do u1 = uniform(0.0, 1.0);
+    while (u1 <= 0.0);
     const double u2 = uniform(0.0, 1.0);
     const double r = std::sqrt(-2.0 * std::log(u1));
     spare_ = r * std::sin(6.283185307179586 * u2);

@@ -26,13 +26,12 @@ template <class T> std::vector<std::string> VGG19Features<T>::default_layers(int
   return out;
 }
 
-template <class T>
-VGG19Features<T>::VGG19Features(const VggWeights& weights, std::vector<std::string> layers) : src_(weights) {
+template <class T> VGG19Features<T>::VGG19Features(const VggWeights& weights, std::vector<std::string> layers)
+    : src_(weights) {
   build(std::move(layers));
 }
 
-template <class T>
-VGG19Features<T>::VGG19Features(const std::string& keras_dir, std::vector<std::string> layers)
+template <class T> VGG19Features<T>::VGG19Features(const std::string& keras_dir, std::vector<std::string> layers)
     : src_(load_vgg19_keras(keras_dir)) {
   build(std::move(layers));
 }
@@ -41,12 +40,14 @@ template <class T> void VGG19Features<T>::build(std::vector<std::string> layers)
   const auto& convs = src_.convs;
   if (convs.empty()) throw ag::Error("VGG19Features: no convolution weights (" + src_.source + ")");
   if (convs.size() > 16) throw ag::Error("VGG19Features: more than 16 convolutions in " + src_.source);
-  if (convs[0].in != 3) throw ag::Error("VGG19Features: the first convolution must take 3 channels (" + src_.source + ")");
+  if (convs[0].in != 3)
+    throw ag::Error("VGG19Features: the first convolution must take 3 channels (" + src_.source + ")");
   for (size_t i = 0; i < convs.size(); ++i) {
     const VggConv& c = convs[i];
     if (i > 0 && c.in != convs[i - 1].out)
-      throw ag::Error("VGG19Features: " + c.name + " takes " + std::to_string(c.in) + " channels, the previous layer gives " +
-                      std::to_string(convs[i - 1].out) + " (" + src_.source + ")");
+      throw ag::Error("VGG19Features: " + c.name + " takes " + std::to_string(c.in) +
+                      " channels, the previous layer gives " + std::to_string(convs[i - 1].out) + " (" + src_.source +
+                      ")");
     if (static_cast<int64_t>(c.weight.size()) != c.out * c.in * 9 || static_cast<int64_t>(c.bias.size()) != c.out)
       throw ag::Error("VGG19Features: " + c.name + " has inconsistent weight sizes (" + src_.source + ")");
   }
@@ -117,8 +118,7 @@ template <class T> std::vector<ag::Tensor<T>> VGG19Features<T>::features(const a
 
   std::vector<T> off(static_cast<size_t>(N * 3 * H * W));
   for (int64_t n = 0; n < N; ++n)
-    for (int c = 0; c < 3; ++c)
-      std::fill_n(off.begin() + (n * 3 + c) * H * W, H * W, -offset_[c]);
+    for (int c = 0; c < 3; ++c) std::fill_n(off.begin() + (n * 3 + c) * H * W, H * W, -offset_[c]);
   ag::Tensor<T> h = ag::add(image, ag::Tensor<T>::from(image.shape(), std::move(off)));
 
   std::vector<ag::Tensor<T>> out(layers_.size());

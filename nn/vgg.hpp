@@ -40,7 +40,7 @@ template <class T> class VGG19Features {
   std::vector<ag::Tensor<T>> w_, b_;  // per conv: [O x C x 3 x 3], [O]; w_[0] has preprocessing folded in
   T offset_[3];                       // per RGB channel, subtracted from the 0..1 input
   std::vector<std::string> layers_;
-  std::vector<int> layer_conv_;       // conv index (0-based) whose ReLU output each layer is
+  std::vector<int> layer_conv_;  // conv index (0-based) whose ReLU output each layer is
 };
 
 }  // namespace nn

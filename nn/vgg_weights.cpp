@@ -10,9 +10,9 @@
 namespace nn {
 
 const std::vector<std::string>& vgg19_conv_names() {
-  static const std::vector<std::string> names = {
-      "conv1_1", "conv1_2", "conv2_1", "conv2_2", "conv3_1", "conv3_2", "conv3_3", "conv3_4",
-      "conv4_1", "conv4_2", "conv4_3", "conv4_4", "conv5_1", "conv5_2", "conv5_3", "conv5_4"};
+  static const std::vector<std::string> names = {"conv1_1", "conv1_2", "conv2_1", "conv2_2", "conv3_1", "conv3_2",
+                                                 "conv3_3", "conv3_4", "conv4_1", "conv4_2", "conv4_3", "conv4_4",
+                                                 "conv5_1", "conv5_2", "conv5_3", "conv5_4"};
   return names;
 }
 

@@ -16,16 +16,16 @@ namespace nn {
 enum class VggPreprocess { CaffeBGR, TorchRGB };
 
 struct VggConv {
-  std::string name;            // e.g. "conv1_1"
-  int64_t in = 0, out = 0;     // channels
-  std::vector<float> weight;   // [out x in x 3 x 3] (cross-correlation, PyTorch/Caffe layout)
-  std::vector<float> bias;     // [out]
+  std::string name;           // e.g. "conv1_1"
+  int64_t in = 0, out = 0;    // channels
+  std::vector<float> weight;  // [out x in x 3 x 3] (cross-correlation, PyTorch/Caffe layout)
+  std::vector<float> bias;    // [out]
 };
 
 struct VggWeights {
   std::vector<VggConv> convs;  // the first convs.size() convolutions of VGG19, in order
   VggPreprocess preprocess = VggPreprocess::CaffeBGR;
-  std::string source;          // path(s) the weights came from (for messages)
+  std::string source;  // path(s) the weights came from (for messages)
 };
 
 // VGG19's 16 convolution names in order: conv1_1, conv1_2, conv2_1, ..., conv5_4.

@@ -20,8 +20,11 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 jobs=$(nproc 2>/dev/null || echo 2)
+# GDSR_CMAKE_ARGS: extra configure flags for a fresh build/ (CI passes -DGDSR_WERROR=ON;
+# -DGDSR_MARCH=x86-64-v2 makes a build that runs on any x86-64 machine from 2009 on).
 if [ ! -f build/CMakeCache.txt ]; then
-  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+  # shellcheck disable=SC2086
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release ${GDSR_CMAKE_ARGS:-} >/dev/null
   echo "setup: first build in build/ (about 10 minutes on 2 cores)"
 fi
 # Progress: the percentages make prints, on one line; the whole log is in build/build.log.

@@ -1,19 +1,24 @@
 // gdsr data make | preview | import-md | check
-#include "train/commands.hpp"
+#include "gdsr/cli/commands.hpp"
 
-#include "gdsr/body.hpp"
-#include "gdsr/correspondence.hpp"
-#include "gdsr/dataset.hpp"
-#include "gdsr/md_import.hpp"
-#include "gdsr/progress.hpp"
-#include "gdsr/render.hpp"
-#include "sim/cloth_solver.hpp"
-#include "sim/garments.hpp"
-#include "sim/sim_metrics.hpp"
+#include "gdsr/error.hpp"
+
+#include "gdsr/body/body.hpp"
+#include "gdsr/geometry/correspondence.hpp"
+#include "gdsr/data/dataset.hpp"
+#include "gdsr/data/md_import.hpp"
+#include "gdsr/data/validity.hpp"
+#include "gdsr/geometry/self_intersections.hpp"
+#include "gdsr/cli/progress_bar.hpp"
+#include "gdsr/io/render.hpp"
+#include "gdsr/sim/cloth_solver.hpp"
+#include "gdsr/sim/garments.hpp"
+#include "gdsr/sim/sim_metrics.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <ctime>
 #include <cstdio>
@@ -23,6 +28,9 @@
 
 namespace {
 
+// Self-intersections on every k-th frame by default (see `data check --help`).
+constexpr int kDefaultIntersectionStride = 1;
+
 struct MakeArgs {
   std::string garment = "skirt_short";
   std::string motion = "/usr/share/assimp/models/BVH/01_01.bvh";
@@ -31,9 +39,10 @@ struct MakeArgs {
   double seconds = 4.0;               // clip length after the rest blend
   double start = 0.0;                 // clip start, seconds
   double fps = 30;
-  int substeps = -1;                  // <0: the solver's default
+  int substeps = -1;  // <0: the solver's default
   int rest_blend_frames = 15;
   int raster = 1024;
+  int intersection_stride = kDefaultIntersectionStride;
 };
 
 double now_seconds() {
@@ -58,7 +67,8 @@ SimRun simulate_one(const MakeArgs& a, double pd, const char* label, const gdsr:
                     const sim::SimParams& params) {
   SimRun r;
   r.garment = sim::make_garment(a.garment, pd, body.rest_mesh());
-  gdsr::ProgressBar bar(std::string("simulate ") + label + " (" + std::to_string(r.garment.mesh.V.rows()) + " vertices)");
+  gdsr::ProgressBar bar(std::string("simulate ") + label + " (" + std::to_string(r.garment.mesh.V.rows()) +
+                        " vertices)");
   const double t0 = now_seconds(), c0 = cpu_seconds();
   r.frames = sim::simulate(r.garment, body, params, bar.callback());
   bar.finish();
@@ -66,52 +76,37 @@ SimRun simulate_one(const MakeArgs& a, double pd, const char* label, const gdsr:
   r.seconds_per_frame = (now_seconds() - t0) / steps;
   r.cpu_seconds_per_frame = (cpu_seconds() - c0) / steps;
   if (r.frames.size() != body.frames.size())
-    throw std::runtime_error(std::string("data make: the ") + label + " simulation returned " +
-                             std::to_string(r.frames.size()) + " frames for " + std::to_string(body.frames.size()) +
-                             " body frames");
+    gdsr::fail("data make", std::string("the ") + label + " simulation returned " + std::to_string(r.frames.size()) +
+                                " frames for " + std::to_string(body.frames.size()) + " body frames");
   return r;
 }
 
-// Means over the frames after the rest blend (all frames if the blend covers everything).
-struct Summary {
-  double hr_curv = 0, up_curv = 0, lr_curv = 0, hr_dih = 0, up_dih = 0;
-  double lr_pen_max = 0, hr_pen_max = 0, lr_pen_mean = 0, hr_pen_mean = 0;
-  sim::StrainEnergies lr_e, hr_e;
-  double lr_ke_max = 0, hr_ke_max = 0;
-};
+// Largest kinetic energy over the clip (joules), from consecutive frames.
+double max_kinetic_energy(const gdsr::GarmentMesh& g, const std::vector<gdsr::Points3>& frames, double fps) {
+  double e = 0;
+  for (size_t t = 1; t < frames.size(); ++t)
+    e = std::max(e, sim::kinetic_energy(g, frames[t - 1], frames[t], 1.0 / fps));
+  return e;
+}
 
-Summary summarize(const gdsr::Dataset& d) {
-  Summary s;
-  const int T = static_cast<int>(d.lr_frames.size());
-  const int first = d.manifest.rest_blend_frames < T ? d.manifest.rest_blend_frames : 0;
-  const auto lr_m = sim::sequence_metrics(d.lr, d.lr_frames, d.body_faces, d.body_frames, d.manifest.fps);
-  const auto hr_m = sim::sequence_metrics(d.hr, d.hr_frames, d.body_faces, d.body_frames, d.manifest.fps);
-  const double n = T - first;
-  for (int t = first; t < T; ++t) {
-    const auto up = sim::wrinkle_measure(gdsr::upsample(d.corr, d.lr_frames[t]), d.hr.F);
-    s.up_curv += up.mean_curvature / n;
-    s.up_dih += up.mean_dihedral / n;
-    s.hr_curv += hr_m[t].wrinkles.mean_curvature / n;
-    s.hr_dih += hr_m[t].wrinkles.mean_dihedral / n;
-    s.lr_curv += lr_m[t].wrinkles.mean_curvature / n;
-    s.lr_pen_max = std::max(s.lr_pen_max, lr_m[t].penetration.max_depth);
-    s.hr_pen_max = std::max(s.hr_pen_max, hr_m[t].penetration.max_depth);
-    s.lr_pen_mean += lr_m[t].penetration.mean_depth / n;
-    s.hr_pen_mean += hr_m[t].penetration.mean_depth / n;
-    for (auto [e, m] : {std::make_pair(&s.lr_e, &lr_m[t]), std::make_pair(&s.hr_e, &hr_m[t])}) {
-      e->E_u += m->strain.E_u / n;
-      e->E_v += m->strain.E_v / n;
-      e->E_uv += m->strain.E_uv / n;
-    }
-    s.lr_ke_max = std::max(s.lr_ke_max, lr_m[t].kinetic_energy);
-    s.hr_ke_max = std::max(s.hr_ke_max, hr_m[t].kinetic_energy);
-  }
-  return s;
+// The frames as the dataset stores them (float32), so that `data make` measures exactly what
+// `data check` later loads.
+void round_to_float(std::vector<gdsr::Points3>& frames) {
+  for (auto& X : frames) X = X.cast<float>().cast<double>();
+}
+
+gdsr::ValidityFigures measure(const gdsr::Dataset& d, const gdsr::ValidityOptions& opt, double& seconds) {
+  gdsr::ProgressBar bar("validity figures");
+  const double t0 = now_seconds();
+  const gdsr::ValidityFigures v = gdsr::measure_validity(d, opt, bar.callback());
+  bar.finish();
+  seconds = now_seconds() - t0;
+  return v;
 }
 
 void run_make(const MakeArgs& a) {
-  if (a.out.empty()) throw std::runtime_error("data make: --out is required");
-  if (!(a.lr_pd > 0) || !(a.hr_pd > 0)) throw std::runtime_error("data make: particle distances must be positive");
+  if (a.out.empty()) gdsr::fail("data make", "--out is required");
+  if (!(a.lr_pd > 0) || !(a.hr_pd > 0)) gdsr::fail("data make", "particle distances must be positive");
   gdsr::BodyOptions bo;
   bo.fps = a.fps;
   bo.rest_blend_frames = a.rest_blend_frames;
@@ -162,39 +157,36 @@ void run_make(const MakeArgs& a) {
                   {"clip_seconds", a.seconds}};
   gdsr::update_manifest_counts(d);
 
-  const Summary s = summarize(d);
+  round_to_float(d.lr_frames);
+  round_to_float(d.hr_frames);
+  round_to_float(d.body_frames);
+  gdsr::ValidityOptions vo;
+  vo.intersection_stride = a.intersection_stride;
+  double validity_seconds = 0;
+  const gdsr::ValidityFigures v = measure(d, vo, validity_seconds);
+  m.validity = gdsr::validity_to_json(v);
+  const double lr_ke = max_kinetic_energy(d.lr, d.lr_frames, m.fps),
+               hr_ke = max_kinetic_energy(d.hr, d.hr_frames, m.fps);
   m.stats = {{"lr_seconds_per_frame", lr.seconds_per_frame},
              {"hr_seconds_per_frame", hr.seconds_per_frame},
              {"lr_cpu_seconds_per_frame", lr.cpu_seconds_per_frame},
              {"hr_cpu_seconds_per_frame", hr.cpu_seconds_per_frame},
-             {"hr_mean_curvature_1_m", s.hr_curv},
-             {"lr_upsampled_mean_curvature_1_m", s.up_curv},
-             {"lr_mean_curvature_1_m", s.lr_curv},
-             {"hr_mean_dihedral_rad", s.hr_dih},
-             {"lr_upsampled_mean_dihedral_rad", s.up_dih},
-             {"lr_max_penetration_m", s.lr_pen_max},
-             {"hr_max_penetration_m", s.hr_pen_max},
-             {"lr_energies", {{"E_u", s.lr_e.E_u}, {"E_v", s.lr_e.E_v}, {"E_uv", s.lr_e.E_uv}}},
-             {"hr_energies", {{"E_u", s.hr_e.E_u}, {"E_v", s.hr_e.E_v}, {"E_uv", s.hr_e.E_uv}}},
-             {"lr_max_kinetic_energy_j", s.lr_ke_max},
-             {"hr_max_kinetic_energy_j", s.hr_ke_max}};
+             {"lr_max_kinetic_energy_j", lr_ke},
+             {"hr_max_kinetic_energy_j", hr_ke}};
   gdsr::write_dataset(a.out, d);
 
   std::printf("dataset %s: %s on %s, %d frames at %g fps\n", a.out.c_str(), a.garment.c_str(), a.motion.c_str(),
               m.frames, m.fps);
   std::printf("  vertices: LR %d (pd %.3g m), HR %d (pd %.3g m), %.1fx; body %d\n", m.lr_vertices, a.lr_pd,
               m.hr_vertices, a.hr_pd, static_cast<double>(m.hr_vertices) / m.lr_vertices, m.body_vertices);
-  std::printf("  seconds per frame (substeps %d): LR %.4f, HR %.4f wall; LR %.4f, HR %.4f CPU; correspondences + raster %.2f s\n",
-              params.substeps, lr.seconds_per_frame, hr.seconds_per_frame, lr.cpu_seconds_per_frame,
-              hr.cpu_seconds_per_frame, corr_seconds);
-  std::printf("  wrinkles (mean |mean curvature|, 1/m): HR %.3f vs LR upsampled to HR %.3f (ratio %.2f); LR own %.3f\n",
-              s.hr_curv, s.up_curv, s.up_curv > 0 ? s.hr_curv / s.up_curv : 0.0, s.lr_curv);
-  std::printf("  mean dihedral on HR topology (rad): HR %.4f vs LR upsampled %.4f\n", s.hr_dih, s.up_dih);
-  std::printf("  body penetration: max LR %.4f m, HR %.4f m; mean LR %.2e m, HR %.2e m\n", s.lr_pen_max, s.hr_pen_max,
-              s.lr_pen_mean, s.hr_pen_mean);
-  std::printf("  strain energies E_u / E_v / E_uv: LR %.4f / %.4f / %.4f, HR %.4f / %.4f / %.4f\n", s.lr_e.E_u, s.lr_e.E_v,
-              s.lr_e.E_uv, s.hr_e.E_u, s.hr_e.E_v, s.hr_e.E_uv);
-  std::printf("  max kinetic energy: LR %.4f J, HR %.4f J\n", s.lr_ke_max, s.hr_ke_max);
+  std::printf(
+      "  seconds per frame (substeps %d): LR %.4f, HR %.4f wall; LR %.4f, HR %.4f CPU; correspondences + raster %.2f "
+      "s\n",
+      params.substeps, lr.seconds_per_frame, hr.seconds_per_frame, lr.cpu_seconds_per_frame, hr.cpu_seconds_per_frame,
+      corr_seconds);
+  std::printf("  max kinetic energy: LR %.4f J, HR %.4f J\n", lr_ke, hr_ke);
+  std::printf("%s", gdsr::validity_table(v).c_str());
+  std::printf("  (validity figures: %.1f s)\n", validity_seconds);
 }
 
 struct PreviewArgs {
@@ -202,16 +194,33 @@ struct PreviewArgs {
   int frame = -1;  // <0: last frame
   int size = 512;
   bool body = true;
+  bool intersections = false;  // paint the faces of intersecting pairs red
 };
+
+// The garment as two meshes: the faces in no intersecting pair, and those in one (CGAL).
+std::vector<gdsr::TriMesh> split_by_intersections(const gdsr::TriMesh& g, int& marked) {
+  const gdsr::SelfIntersections si = gdsr::self_intersections(g.V, g.F, /*list_pairs=*/true);
+  std::vector<char> hit(g.F.rows(), 0);
+  for (const auto& [f, h] : si.list) hit[f] = hit[h] = 1;
+  marked = static_cast<int>(std::count(hit.begin(), hit.end(), 1));
+  std::vector<gdsr::TriMesh> parts(2, gdsr::TriMesh{g.V, gdsr::Faces(0, 3)});
+  for (int k = 0; k < 2; ++k) {
+    parts[k].F.resize(k ? marked : g.F.rows() - marked, 3);
+    int n = 0;
+    for (int f = 0; f < g.F.rows(); ++f)
+      if (hit[f] == k) parts[k].F.row(n++) = g.F.row(f);
+  }
+  return parts;
+}
 
 void run_preview(const PreviewArgs& a) {
   const gdsr::Dataset d = gdsr::load_dataset(a.data);
   const int T = d.manifest.frames;
-  if (T == 0) throw std::runtime_error("data preview: " + a.data + " has no frames");
+  if (T == 0) gdsr::fail("data preview", a.data + " has no frames");
   const int t = a.frame < 0 ? T - 1 : a.frame;
   if (t >= T)
-    throw std::runtime_error("data preview: frame " + std::to_string(t) + " out of range (dataset has " +
-                             std::to_string(T) + " frames)");
+    gdsr::fail("data preview",
+               "frame " + std::to_string(t) + " out of range (dataset has " + std::to_string(T) + " frames)");
   const gdsr::TriMesh lr{d.lr_frames[t], d.lr.F}, hr{d.hr_frames[t], d.hr.F};
   // One camera for both images: framed on the HR garment (and the body around it).
   gdsr::Points3 all = hr.V;
@@ -223,17 +232,30 @@ void run_preview(const PreviewArgs& a) {
   const cv::Vec3b body_c(200, 200, 200), lr_c(70, 120, 230), hr_c(60, 170, 90);  // BGR
   std::vector<gdsr::TriMesh> with_body;
   if (a.body && d.has_body()) with_body.push_back(gdsr::TriMesh{d.body_frames[t], d.body_faces});
-  auto render = [&](const gdsr::TriMesh& g, const cv::Vec3b& c) {
+  const cv::Vec3b hit_c(40, 40, 220);
+  std::string lr_note, hr_note;
+  auto render = [&](const gdsr::TriMesh& g, const cv::Vec3b& c, std::string& note) {
     std::vector<gdsr::TriMesh> meshes = with_body;
-    meshes.push_back(g);
     std::vector<cv::Vec3b> colours(with_body.size(), body_c);
-    colours.push_back(c);
+    if (a.intersections) {
+      int marked = 0;
+      const std::vector<gdsr::TriMesh> parts = split_by_intersections(g, marked);
+      for (int k = 0; k < 2; ++k)
+        if (parts[k].F.rows() > 0) {  // the renderer refuses empty meshes
+          meshes.push_back(parts[k]);
+          colours.push_back(k ? hit_c : c);
+        }
+      note = ", " + std::to_string(marked) + " faces intersect";
+    } else {
+      meshes.push_back(g);
+      colours.push_back(c);
+    }
     return gdsr::render_meshes(meshes, colours, opt);
   };
+  const cv::Mat lr_img = render(lr, lr_c, lr_note), hr_img = render(hr, hr_c, hr_note);
   const cv::Mat img = gdsr::side_by_side(
-      {render(lr, lr_c), render(hr, hr_c)},
-      {"LR " + std::to_string(lr.num_vertices()) + " verts, frame " + std::to_string(t),
-       "HR " + std::to_string(hr.num_vertices()) + " verts, frame " + std::to_string(t)});
+      {lr_img, hr_img}, {"LR " + std::to_string(lr.num_vertices()) + " verts, frame " + std::to_string(t) + lr_note,
+                         "HR " + std::to_string(hr.num_vertices()) + " verts, frame " + std::to_string(t) + hr_note});
   gdsr::write_png_atomic(a.out, img);
   std::printf("wrote %s (%d x %d): frame %d of %d, LR %d / HR %d vertices\n", a.out.c_str(), img.cols, img.rows, t, T,
               lr.num_vertices(), hr.num_vertices());
@@ -256,13 +278,39 @@ void run_import(const ImportArgs& a) {
               m.garment.c_str(), m.frames, m.fps, m.lr_vertices, m.hr_vertices, m.body_vertices, a.out.c_str());
 }
 
-void run_check(const std::string& dir) {
-  const gdsr::Dataset d = gdsr::load_dataset(dir);
+struct CheckArgs {
+  std::string data;
+  int intersection_stride = kDefaultIntersectionStride;
+  bool body = true;
+};
+
+// "same" if every number of `a` equals the one at the same place in `b` (relative 1e-9),
+// else the path of the first difference.
+std::string compare_json(const nlohmann::json& a, const nlohmann::json& b, const std::string& path = "") {
+  if (a.is_object()) {
+    if (!b.is_object()) return path;
+    for (auto it = a.begin(); it != a.end(); ++it) {
+      if (!b.contains(it.key())) return path + it.key();
+      const std::string d = compare_json(it.value(), b[it.key()], path + it.key() + ".");
+      if (d != "same") return d;
+    }
+    return "same";
+  }
+  if (a.is_number() && b.is_number()) {
+    const double x = a.get<double>(), y = b.get<double>();
+    return std::abs(x - y) <= 1e-9 * std::max({1.0, std::abs(x), std::abs(y)}) ? "same"
+                                                                               : path.substr(0, path.size() - 1);
+  }
+  return a == b ? "same" : path.substr(0, path.size() - 1);
+}
+
+void run_check(const CheckArgs& a) {
+  const gdsr::Dataset d = gdsr::load_dataset(a.data);
   const auto& m = d.manifest;
   int covered = 0;
   for (int t : d.raster.tri) covered += t >= 0;
-  std::printf("dataset %s: garment %s, %d layer(s), %d frames at %g fps (source %s)\n", dir.c_str(), m.garment.c_str(),
-              m.layers, m.frames, m.fps, m.source_motion.c_str());
+  std::printf("dataset %s: garment %s, %d layer(s), %d frames at %g fps (source %s)\n", a.data.c_str(),
+              m.garment.c_str(), m.layers, m.frames, m.fps, m.source_motion.c_str());
   std::printf("  LR: %d vertices, %d faces, %d UV vertices (particle distance %.4g m)\n", m.lr_vertices, m.lr_faces,
               m.lr_uv_vertices, m.lr_particle_distance);
   std::printf("  HR: %d vertices, %d faces, %d UV vertices (particle distance %.4g m)\n", m.hr_vertices, m.hr_faces,
@@ -270,6 +318,32 @@ void run_check(const std::string& dir) {
   std::printf("  body: %d vertices, %d faces\n", m.body_vertices, m.body_faces);
   std::printf("  UV raster: %d x %d, %.1f%% of pixels covered\n", d.raster.width, d.raster.height,
               100.0 * covered / std::max<size_t>(1, d.raster.tri.size()));
+  std::fflush(stdout);
+  if (m.frames > 0) {
+    gdsr::ValidityOptions vo;
+    vo.intersection_stride = a.intersection_stride;
+    vo.body = a.body;
+    double seconds = 0;
+    const gdsr::ValidityFigures v = measure(d, vo, seconds);
+    std::printf("%s", gdsr::validity_table(v).c_str());
+    std::printf("  (validity figures: %.1f s)\n", seconds);
+    if (m.validity.empty()) {
+      std::printf("  manifest: no validity figures stored\n");
+    } else {
+      const gdsr::ValidityFigures stored = gdsr::validity_from_json(m.validity);
+      if (stored.intersection_stride != v.intersection_stride || stored.body_measured != v.body_measured)
+        std::printf("  manifest: validity figures stored with stride %d%s; not compared\n", stored.intersection_stride,
+                    stored.body_measured ? " and the body" : " and no body");
+      else {
+        const std::string diff = compare_json(gdsr::validity_to_json(v), m.validity);
+        if (diff == "same")
+          std::printf("  manifest: stored validity figures agree with the recomputed ones\n");
+        else
+          std::printf("  manifest: stored validity figures DIFFER from the recomputed ones (first at '%s')\n",
+                      diff.c_str());
+      }
+    }
+  }
   std::printf("ok\n");
 }
 
@@ -281,7 +355,9 @@ void add_data_command(CLI::App& app) {
 
   auto mk = std::make_shared<MakeArgs>();
   CLI::App* make = data->add_subcommand("make", "simulate a garment at LR and HR on a motion and write a dataset");
-  make->add_option("--garment", mk->garment, "garment name")->capture_default_str()->check(CLI::IsMember(sim::garment_names()));
+  make->add_option("--garment", mk->garment, "garment name")
+      ->capture_default_str()
+      ->check(CLI::IsMember(sim::garment_names()));
   make->add_option("--motion", mk->motion, "motion file (BVH, FBX, glTF, Collada)")->capture_default_str();
   make->add_option("--out", mk->out, "dataset folder to write (atomically)")->required();
   make->add_option("--lr-pd", mk->lr_pd, "LR particle distance, metres")->capture_default_str();
@@ -292,6 +368,9 @@ void add_data_command(CLI::App& app) {
   make->add_option("--substeps", mk->substeps, "solver substeps per frame (default: the solver's)");
   make->add_option("--rest-blend", mk->rest_blend_frames, "frames blending from the rest pose")->capture_default_str();
   make->add_option("--raster", mk->raster, "UV raster size in pixels")->capture_default_str();
+  make->add_option("--intersection-stride", mk->intersection_stride, "count self-intersections on every k-th frame")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   make->callback([mk]() { run_make(*mk); });
 
   auto pv = std::make_shared<PreviewArgs>();
@@ -301,6 +380,7 @@ void add_data_command(CLI::App& app) {
   prev->add_option("--out", pv->out, "PNG file to write")->required();
   prev->add_option("--size", pv->size, "pixels per image side")->capture_default_str();
   prev->add_flag("!--no-body", pv->body, "leave the body out");
+  prev->add_flag("--intersections", pv->intersections, "paint faces in self-intersecting pairs (CGAL) red");
   prev->callback([pv]() { run_preview(*pv); });
 
   auto imp = std::make_shared<ImportArgs>();
@@ -317,8 +397,12 @@ void add_data_command(CLI::App& app) {
   im->add_option("--out", imp->out, "dataset folder to write")->required();
   im->callback([imp]() { run_import(*imp); });
 
-  auto check_dir = std::make_shared<std::string>();
-  CLI::App* ch = data->add_subcommand("check", "load a dataset, validate it and print its counts");
-  ch->add_option("--data", *check_dir, "dataset folder")->required();
-  ch->callback([check_dir]() { run_check(*check_dir); });
+  auto chk = std::make_shared<CheckArgs>();
+  CLI::App* ch = data->add_subcommand("check", "load a dataset, validate it, print its counts and validity figures");
+  ch->add_option("--data", chk->data, "dataset folder")->required();
+  ch->add_option("--intersection-stride", chk->intersection_stride, "count self-intersections on every k-th frame")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  ch->add_flag("!--no-body", chk->body, "do not measure the body penetration");
+  ch->callback([chk]() { run_check(*chk); });
 }

@@ -3,9 +3,11 @@
 //   1. our autograd + AdamW train a small MLP (loss falls);
 //   2. gradient-check summary over every op (float64 central differences).
 #include "autograd/gradcheck_suite.hpp"
-#include "gdsr/progress.hpp"
-#include "nn/demo_mlp.hpp"
-#include "train/commands.hpp"
+
+#include "gdsr/error.hpp"
+#include "gdsr/cli/progress_bar.hpp"
+#include "train/demo_mlp.hpp"
+#include "gdsr/cli/commands.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -45,7 +47,7 @@ void stage_gradcheck() {
     worst = std::max(worst, r.result.max_rel_error);
   }
   std::printf("  %zu ops checked, worst %.2e, %d above tolerance 1e-6\n", results.size(), worst, failed);
-  if (failed) throw std::runtime_error("demo: " + std::to_string(failed) + " gradient checks failed");
+  if (failed) gdsr::fail("demo", std::to_string(failed) + " gradient checks failed");
 }
 
 }  // namespace

@@ -1,10 +1,10 @@
 // gdsr train: fit a GDSR model to one or more datasets (gdsr/trainer.hpp).
-#include "gdsr/dataset.hpp"
-#include "gdsr/losses.hpp"
-#include "gdsr/model_config.hpp"
-#include "gdsr/progress.hpp"
-#include "gdsr/trainer.hpp"
-#include "train/commands.hpp"
+#include "gdsr/data/dataset.hpp"
+#include "train/losses.hpp"
+#include "gdsr/model/model_config.hpp"
+#include "gdsr/cli/progress_bar.hpp"
+#include "train/trainer.hpp"
+#include "gdsr/cli/commands.hpp"
 
 #include <CLI/CLI.hpp>
 

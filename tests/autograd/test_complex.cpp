@@ -1,5 +1,5 @@
 // Gradient checks of complex_from, real, imag and modulus.
-#include "ag_test_util.hpp"
+#include "tests/support/ag_test_util.hpp"
 
 using namespace agt;
 using ag::Tensorcd;
@@ -23,8 +23,9 @@ TEST_CASE("complex: from / real / imag / modulus gradients") {
              {re, im});
   for (double s : {1e-3, 1e3}) {
     INFO("scale " << s);
-    check_grad("modulus scaled", kTol, [](auto& in) { return ag::modulus(cplx(in[0], in[1])); },
-               {randn({4, 3}, 3, s), randn({4, 3}, 4, s)}, step_for_scale(s));
+    check_grad(
+        "modulus scaled", kTol, [](auto& in) { return ag::modulus(cplx(in[0], in[1])); },
+        {randn({4, 3}, 3, s), randn({4, 3}, 4, s)}, step_for_scale(s));
   }
 }
 
@@ -39,7 +40,8 @@ TEST_CASE("complex: values and the gradient convention grad = dL/dRe + i dL/dIm"
   Tensorcd w = Tensorcd::from({1, 1}, {{1.0, 2.0}}, true);
   sum(ag::imag(w * w)).backward();  // Im(w^2) = 2ab: d/da = 2b = 4, d/db = 2a = 2
   CHECK(std::abs(w.grad()[0] - std::complex<double>(4, 2)) < 1e-15);
-  CHECK_THROWS_WITH_AS(ag::complex_from(randn({2, 2}, 1), randn({2, 3}, 2)), doctest::Contains("complex_from"), ag::Error);
+  CHECK_THROWS_WITH_AS(ag::complex_from(randn({2, 2}, 1), randn({2, 3}, 2)), doctest::Contains("complex_from"),
+                       ag::Error);
 }
 
 TEST_CASE("complex: float32 matches float64 within 1e-5") {

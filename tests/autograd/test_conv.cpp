@@ -1,5 +1,5 @@
 // conv2d_3x3, avg_pool2x2, max_pool2x2: values against direct loops, float64 gradient checks.
-#include "ag_test_util.hpp"
+#include "tests/support/ag_test_util.hpp"
 
 using namespace agt;
 

@@ -1,5 +1,5 @@
 // Graph mechanics: backward rules, accumulation, no-grad scope, detach, freeing.
-#include "ag_test_util.hpp"
+#include "tests/support/ag_test_util.hpp"
 
 using namespace agt;
 

@@ -1,6 +1,6 @@
 // Gradient checks of the elementwise ops: binary ops with broadcasting, unary math, atan2
 // and sqrt at their extremes, complex arithmetic, float32 vs float64.
-#include "ag_test_util.hpp"
+#include "tests/support/ag_test_util.hpp"
 
 using namespace agt;
 using ag::Tensorcd;
@@ -81,8 +81,7 @@ TEST_CASE("elementwise: unary math on random inputs") {
 
 TEST_CASE("elementwise: unary values match std") {
   const Tensord x = randn({3, 3}, 23);
-  const Tensord r = ag::relu(x), l = ag::leaky_relu(x, 0.02), s = ag::sigmoid(x),
-                c = ag::clamp(x, -0.5, 0.7);
+  const Tensord r = ag::relu(x), l = ag::leaky_relu(x, 0.02), s = ag::sigmoid(x), c = ag::clamp(x, -0.5, 0.7);
   for (int64_t i = 0; i < x.numel(); ++i) {
     const double v = x.data()[i];
     CHECK(r.data()[i] == std::max(v, 0.0));
@@ -103,10 +102,10 @@ TEST_CASE("elementwise: sqrt near 0 (small positive)") {
   // 1e-11; truncation error (h/x)^2 < 1e-10, round-off well below the tolerance.
   ag::GradCheckOptions opt;
   opt.step = 1e-11;
-  check_grad("sqrt near 0", kTol, [](auto& in) { return ag::sqrt(in[0]); },
-             {randu({4, 4}, 31, 1e-6, 1e-5)}, opt);
-  check_grad("log near 0", kTol, [](auto& in) { return ag::log(in[0]); },
-             {randu({4, 4}, 32, 1e-6, 1e-5)}, opt);
+  check_grad(
+      "sqrt near 0", kTol, [](auto& in) { return ag::sqrt(in[0]); }, {randu({4, 4}, 31, 1e-6, 1e-5)}, opt);
+  check_grad(
+      "log near 0", kTol, [](auto& in) { return ag::log(in[0]); }, {randu({4, 4}, 32, 1e-6, 1e-5)}, opt);
 }
 
 TEST_CASE("elementwise: atan2 on random inputs, near 0 and near pi") {
@@ -121,8 +120,9 @@ TEST_CASE("elementwise: atan2 on random inputs, near 0 and near pi") {
   // (h/x)^2 ~ 1e-7) keeps that round-off below the 1e-6 tolerance.
   ag::GradCheckOptions near_pi;
   near_pi.step = 1e-4;
-  check_grad("atan2 near pi", kTol, [](auto& in) { return ag::atan2(in[0], in[1]); },
-             {rand_signed({5, 4}, 45, 1e-3, 1e-2), randu({5, 4}, 46, -2.0, -0.5)}, near_pi);
+  check_grad(
+      "atan2 near pi", kTol, [](auto& in) { return ag::atan2(in[0], in[1]); },
+      {rand_signed({5, 4}, 45, 1e-3, 1e-2), randu({5, 4}, 46, -2.0, -0.5)}, near_pi);
   // exactly on the cut and at the origin: values +-pi and 0, gradients finite
   Tensord y = Tensord::from({1, 4}, {0.0, -0.0, 1e-300, 0.0}, true);
   Tensord x = Tensord::from({1, 4}, {-1.0, -1.0, -1.0, 0.0}, true);
@@ -143,27 +143,36 @@ TEST_CASE("elementwise: inputs scaled by 1e-3 and 1e3") {
     INFO("scale " << s);
     const ag::GradCheckOptions opt = step_for_scale(s);
     const Tensord a = randn({4, 3}, 51, s), b = randn({4, 3}, 52, s);
-    check_grad("mul scaled", kTol, [](auto& in) { return in[0] * in[1]; }, {a, b}, opt);
-    check_grad("div scaled", kTol, [](auto& in) { return in[0] / in[1]; }, {a, randu({4, 3}, 53, s, 2 * s)}, opt);
-    check_grad("atan2 scaled", kTol, [](auto& in) { return ag::atan2(in[0], in[1]); }, {a, b}, opt);
-    check_grad("sqrt scaled", kTol, [](auto& in) { return ag::sqrt(in[0]); }, {randu({4, 3}, 54, s, 3 * s)}, opt);
-    check_grad("log scaled", kTol, [](auto& in) { return ag::log(in[0]); }, {randu({4, 3}, 55, s, 3 * s)}, opt);
-    check_grad("tanh scaled", kTol, [s](auto& in) { return ag::tanh(in[0] * (1.0 / s)); }, {a}, opt);
+    check_grad(
+        "mul scaled", kTol, [](auto& in) { return in[0] * in[1]; }, {a, b}, opt);
+    check_grad(
+        "div scaled", kTol, [](auto& in) { return in[0] / in[1]; }, {a, randu({4, 3}, 53, s, 2 * s)}, opt);
+    check_grad(
+        "atan2 scaled", kTol, [](auto& in) { return ag::atan2(in[0], in[1]); }, {a, b}, opt);
+    check_grad(
+        "sqrt scaled", kTol, [](auto& in) { return ag::sqrt(in[0]); }, {randu({4, 3}, 54, s, 3 * s)}, opt);
+    check_grad(
+        "log scaled", kTol, [](auto& in) { return ag::log(in[0]); }, {randu({4, 3}, 55, s, 3 * s)}, opt);
+    check_grad(
+        "tanh scaled", kTol, [s](auto& in) { return ag::tanh(in[0] * (1.0 / s)); }, {a}, opt);
   }
 }
 
 TEST_CASE("elementwise: complex add, sub, mul, div") {
-  const Tensord ar = randn({3, 4}, 61), ai = randn({3, 4}, 62), br = randn({3, 4}, 63),
-                bi = randn({3, 4}, 64);
+  const Tensord ar = randn({3, 4}, 61), ai = randn({3, 4}, 62), br = randn({3, 4}, 63), bi = randn({3, 4}, 64);
   const Tensord rr = randn({1, 4}, 65), ri = randn({1, 4}, 66);
   auto bin = [](int op) {
     return [op](const std::vector<Tensord>& in) {
       const Tensorcd a = cplx(in[0], in[1]), b = cplx(in[2], in[3]);
       switch (op) {
-        case 0: return split(a + b);
-        case 1: return split(a - b);
-        case 2: return split(a * b);
-        default: return split(a / b);
+        case 0:
+          return split(a + b);
+        case 1:
+          return split(a - b);
+        case 2:
+          return split(a * b);
+        default:
+          return split(a / b);
       }
     };
   };
@@ -175,8 +184,8 @@ TEST_CASE("elementwise: complex add, sub, mul, div") {
   // values
   const Tensorcd a = cplx(ar, ai), b = cplx(br, bi), p = a * b;
   for (int64_t i = 0; i < p.numel(); ++i) {
-    const std::complex<double> e = std::complex<double>(ar.data()[i], ai.data()[i]) *
-                                   std::complex<double>(br.data()[i], bi.data()[i]);
+    const std::complex<double> e =
+        std::complex<double>(ar.data()[i], ai.data()[i]) * std::complex<double>(br.data()[i], bi.data()[i]);
     CHECK(std::abs(p.data()[i] - e) < 1e-14);
   }
 }
@@ -186,8 +195,8 @@ TEST_CASE("elementwise: float32 matches float64 within 1e-5") {
   auto f = [](const auto& x, const auto& y, const auto& yp) {
     using T = typename std::decay_t<decltype(x)>::Scalar;
     auto t = ag::tanh(x * y) + ag::sigmoid(x) / yp - ag::leaky_relu(x, T(0.02)) +
-             ag::sqrt(yp) * ag::exp(ag::clamp(x, T(-1), T(1))) + ag::atan2(x, y) +
-             ag::log(yp) - ag::pow(yp, T(1.5)) + ag::sin(x) * ag::cos(y) + ag::abs(y);
+             ag::sqrt(yp) * ag::exp(ag::clamp(x, T(-1), T(1))) + ag::atan2(x, y) + ag::log(yp) - ag::pow(yp, T(1.5)) +
+             ag::sin(x) * ag::cos(y) + ag::abs(y);
     return t;
   };
   const auto d = f(a, b, bp);

@@ -22,8 +22,7 @@ TEST_CASE("gradcheck suite: every op passes at 1e-6 on random inputs") {
 
 TEST_CASE("gradcheck: a wrong backward is caught") {
   // d/dx of x * x computed through a detached copy of one factor: half the true gradient.
-  const auto r = ag::gradcheck(
-      [](const std::vector<ag::Tensord>& x) { return ag::mul(x[0], x[0].detach()); },
-      {ag::Tensord::from({2, 2}, {0.5, -1.0, 2.0, 1.5})});
+  const auto r = ag::gradcheck([](const std::vector<ag::Tensord>& x) { return ag::mul(x[0], x[0].detach()); },
+                               {ag::Tensord::from({2, 2}, {0.5, -1.0, 2.0, 1.5})});
   CHECK(r.max_rel_error > 0.4);
 }

@@ -1,5 +1,7 @@
 // Gradient checks and reference comparisons of grouped_linear (real and complex).
-#include "ag_test_util.hpp"
+#include "tests/support/ag_test_util.hpp"
+
+#include <omp.h>
 
 using namespace agt;
 using ag::Tensorcd;
@@ -79,10 +81,120 @@ TEST_CASE("grouped_linear: large parallel case matches the per-row reference") {
   CHECK(err < 1e-5);
 }
 
+// Sorted complex groups run the SIMD kernel (grouped_kernel.hpp): widths with partial
+// packets, groups longer than one packet of rows, an empty group.
+TEST_CASE("grouped_linear: complex kernel (sorted groups) gradient") {
+  for (const auto& [in, out] : {std::pair<int64_t, int64_t>{3, 2}, {9, 5}, {5, 11}}) {
+    const int64_t G = 4, N = 23;
+    const Tensord xr = randn({N, in}, 21), xi = randn({N, in}, 22), wr = randn({G, out * in}, 23),
+                  wi = randn({G, out * in}, 24), br = randn({G, out}, 25), bi = randn({G, out}, 26);
+    ag::Index g = rand_index(N, G - 1, 27);  // group G-1 empty
+    g[0] = 0;
+    for (int64_t k = 1; k <= 12; ++k) g[k] = 1;  // one long group
+    std::sort(g.begin(), g.end());
+    const int64_t o = out;
+    check_grad("complex grouped_linear kernel " + std::to_string(in) + "x" + std::to_string(out), kTol,
+               [g, o](auto& v) {
+                 return split(ag::grouped_linear(cplx(v[0], v[1]), cplx(v[2], v[3]), cplx(v[4], v[5]), g, o));
+               },
+               {xr, xi, wr, wi, br, bi});
+    check_grad(
+        "complex grouped_linear kernel no bias", kTol,
+        [g, o](auto& v) { return split(ag::grouped_linear(cplx(v[0], v[1]), cplx(v[2], v[3]), ag::Tensorcd(), g, o)); },
+        {xr, xi, wr, wi});
+  }
+}
+
+namespace {
+// Value and all three gradients of sum(Re(c * y)) for the field's shape (64 x 64 complex,
+// ~6.5 rows per group), with a given thread count.
+struct GroupedRun {
+  std::vector<std::complex<double>> y, dx, dw, db;
+};
+GroupedRun run_grouped(const Tensorcd& x0, const Tensorcd& w0, const Tensorcd& b0, const Tensorcd& c,
+                       const ag::Index& g, int64_t out, int threads) {
+  omp_set_num_threads(threads);
+  Tensorcd x = x0.detach().set_requires_grad(true), w = w0.detach().set_requires_grad(true),
+           b = b0.detach().set_requires_grad(true);
+  const Tensorcd y = ag::grouped_linear(x, w, b, g, out);
+  ag::sum(ag::real(ag::mul(y, c))).backward();
+  omp_set_num_threads(omp_get_num_procs());
+  return {y.values(), x.grad(), w.grad(), b.grad()};
+}
+}  // namespace
+
+TEST_CASE("grouped_linear: complex kernel at the field's size matches a per-row reference, any thread count") {
+  const int64_t G = 230, in = 64, out = 64, N = 1500;
+  const Tensorcd x = cplx(randn({N, in}, 31), randn({N, in}, 32));
+  const Tensorcd w = cplx(randn({G, out * in}, 33, 0.1), randn({G, out * in}, 34, 0.1));
+  const Tensorcd b = cplx(randn({G, out}, 35), randn({G, out}, 36));
+  const Tensorcd c = cplx(randn({N, out}, 37), randn({N, out}, 38));
+  ag::Index g = rand_index(N, G, 39);
+  std::sort(g.begin(), g.end());
+  const GroupedRun r1 = run_grouped(x, w, b, c, g, out, 1), r2 = run_grouped(x, w, b, c, g, out, 2);
+  CHECK(r1.y == r2.y);  // bit for bit: each group is computed by one thread
+  CHECK(r1.dx == r2.dx);
+  CHECK(r1.dw == r2.dw);
+  CHECK(r1.db == r2.db);
+  // Reference: y = W x + b per row; the loss is sum Re(c y), so grad y = conj(c) and
+  // dx = W^H conj(c), dW += conj(c) x^H (PyTorch's convention, see tensor.hpp).
+  const Eigen::MatrixXcd yref = reference(x, w, b, g, out);
+  double ey = 0, ex = 0, ew = 0, eb = 0;
+  Eigen::MatrixXcd dw = Eigen::MatrixXcd::Zero(G, out * in), db = Eigen::MatrixXcd::Zero(G, out);
+  for (int64_t n = 0; n < N; ++n) {
+    const auto W = ag::ConstMatMap<std::complex<double>>(w.data() + g[n] * out * in, out, in);
+    const Eigen::VectorXcd gy = c.mat().row(n).conjugate().transpose();
+    const Eigen::VectorXcd xn = x.mat().row(n).transpose();
+    const Eigen::VectorXcd dxn = W.adjoint() * gy;
+    for (int64_t i = 0; i < in; ++i) ex = std::max(ex, std::abs(r1.dx[n * in + i] - dxn[i]));
+    for (int64_t o = 0; o < out; ++o) {
+      ey = std::max(ey, std::abs(r1.y[n * out + o] - yref(n, o)));
+      db(g[n], o) += gy[o];
+      for (int64_t i = 0; i < in; ++i) dw(g[n], o * in + i) += gy[o] * std::conj(xn[i]);
+    }
+  }
+  for (int64_t k = 0; k < G; ++k) {
+    for (int64_t j = 0; j < out * in; ++j) ew = std::max(ew, std::abs(r1.dw[k * out * in + j] - dw(k, j)));
+    for (int64_t o = 0; o < out; ++o) eb = std::max(eb, std::abs(r1.db[k * out + o] - db(k, o)));
+  }
+  CHECK(ey < 1e-12);
+  CHECK(ex < 1e-12);
+  CHECK(ew < 1e-12);
+  CHECK(eb < 1e-12);
+}
+
 TEST_CASE("grouped_linear: errors name the op and the shapes") {
   const Tensord x = randn({4, 3}, 1), w = randn({2, 6}, 2);
-  CHECK_THROWS_WITH_AS(ag::grouped_linear(x, w, Tensord(), {0, 1, 0, 2}, 2), doctest::Contains("grouped_linear"), ag::Error);
+  CHECK_THROWS_WITH_AS(ag::grouped_linear(x, w, Tensord(), {0, 1, 0, 2}, 2), doctest::Contains("grouped_linear"),
+                       ag::Error);
   CHECK_THROWS_WITH_AS(ag::grouped_linear(x, w, Tensord(), {0, 1, 0}, 2), doctest::Contains("[4 x 3]"), ag::Error);
   CHECK_THROWS_WITH_AS(ag::grouped_linear(x, w, Tensord(), {0, 1, 0, 1}, 3), doctest::Contains("[2 x 6]"), ag::Error);
-  CHECK_THROWS_WITH_AS(ag::grouped_linear(x, w, randn({2, 3}, 3), {0, 1, 0, 1}, 2), doctest::Contains("[2 x 3]"), ag::Error);
+  CHECK_THROWS_WITH_AS(ag::grouped_linear(x, w, randn({2, 3}, 3), {0, 1, 0, 1}, 2), doctest::Contains("[2 x 3]"),
+                       ag::Error);
+}
+
+TEST_CASE("grouped_linear_planes: gradient, and equal to grouped_linear on sliced planes") {
+  const int64_t G = 4, in = 5, out = 3, N = 17, P = 2 + in * out + out + 4;  // weights at 2, bias after
+  const int64_t wb = 2, bb = 2 + in * out;
+  const Tensord xr = randn({N, in}, 51), xi = randn({N, in}, 52), re = randn({G, P}, 53), im = randn({G, P}, 54);
+  ag::Index g = rand_index(N, G - 1, 55);
+  std::sort(g.begin(), g.end());
+  check_grad("grouped_linear_planes", kTol,
+             [g](auto& v) { return split(ag::grouped_linear_planes(cplx(v[0], v[1]), v[2], v[3], 2, 2 + 15, g, 3)); },
+             {xr, xi, re, im});
+  check_grad("grouped_linear_planes no bias", kTol,
+             [g](auto& v) { return split(ag::grouped_linear_planes(cplx(v[0], v[1]), v[2], v[3], 2, -1, g, 3)); },
+             {xr, xi, re, im});
+  // Same value as the sliced and interleaved weights through grouped_linear (general path).
+  const Tensorcd x = cplx(xr, xi);
+  const Tensorcd w = cplx(ag::slice_cols(re, wb, wb + in * out), ag::slice_cols(im, wb, wb + in * out));
+  const Tensorcd b = cplx(ag::slice_cols(re, bb, bb + out), ag::slice_cols(im, bb, bb + out));
+  const Tensorcd y = ag::grouped_linear_planes(x, re, im, wb, bb, g, out);
+  CHECK((y.mat() - reference(x, w, b, g, out)).cwiseAbs().maxCoeff() < 1e-13);
+  ag::Index unsorted = g;
+  std::swap(unsorted[0], unsorted[N - 1]);
+  CHECK_THROWS_WITH_AS(ag::grouped_linear_planes(x, re, im, wb, bb, unsorted, out), doctest::Contains("sorted"),
+                       ag::Error);
+  CHECK_THROWS_WITH_AS(ag::grouped_linear_planes(x, re, im, P - 3, bb, g, out), doctest::Contains("do not fit"),
+                       ag::Error);
 }

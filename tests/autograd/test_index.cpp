@@ -1,5 +1,7 @@
 // Gradient checks of gather / scatter / interpolate.
-#include "ag_test_util.hpp"
+#include "tests/support/ag_test_util.hpp"
+
+#include <omp.h>
 
 using namespace agt;
 
@@ -38,8 +40,7 @@ TEST_CASE("index: interpolate_rows w.r.t. x and weight") {
   const Tensord x = randn({6, 4}, 3);
   const Tensord w = randu({5, 3}, 4, 0.0, 1.0);
   const ag::Index idx = rand_index(5 * 3, 6, 5);
-  check_grad("interpolate_rows", kTol,
-             [idx](auto& in) { return ag::interpolate_rows(in[0], idx, in[1]); }, {x, w});
+  check_grad("interpolate_rows", kTol, [idx](auto& in) { return ag::interpolate_rows(in[0], idx, in[1]); }, {x, w});
   const Tensord y = ag::interpolate_rows(x, idx, w);
   double e = 0;
   for (int k = 0; k < 3; ++k) e += w.at(2, k) * x.at(idx[2 * 3 + k], 1);
@@ -84,4 +85,36 @@ TEST_CASE("index: large parallel gather/scatter agree with a serial reference") 
   for (int64_t i = 0; i < N; ++i)
     for (int64_t j = 0; j < C; ++j) err = std::max(err, std::abs(xl.grad()[i * C + j] - w.at(idx[i], j)));
   CHECK(err == 0.0);
+}
+
+namespace {
+// All scatter-type results of one graph of gathers and scatters, with a given thread count.
+std::vector<std::vector<double>> scatter_results(int threads) {
+  const int64_t R = 2000, N = 30000, C = 16;
+  const Tensord x0 = randn({N, C}, 41), v0 = randn({R, C}, 42), w0 = randu({N, 3}, 43, 0.0, 1.0);
+  const ag::Index idx = rand_index(N, R, 44), tri = rand_index(N * 3, R, 45);
+  omp_set_num_threads(threads);
+  Tensord x = x0.detach().set_requires_grad(true), v = v0.detach().set_requires_grad(true),
+          w = w0.detach().set_requires_grad(true);
+  const Tensord s = ag::scatter_add_rows(x, idx, R), m = ag::scatter_mean_rows(x, idx, R);
+  const Tensord gsel = ag::index_select_rows(v, idx), ip = ag::interpolate_rows(v, tri, w);
+  const Tensord c = randn({N, C}, 46);
+  (ag::sum(ag::mul(s, s)) + ag::sum(m) + ag::sum(ag::mul(ag::index_select_rows(s, idx) + gsel + ip, c))).backward();
+  omp_set_num_threads(omp_get_num_procs());
+  return {s.values(), m.values(), x.grad(), v.grad(), w.grad()};
+}
+}  // namespace
+
+TEST_CASE("index: scatters are deterministic across thread counts and sum in index order") {
+  const auto r1 = scatter_results(1), r2 = scatter_results(2);
+  REQUIRE(r1.size() == r2.size());
+  for (size_t k = 0; k < r1.size(); ++k) CHECK(r1[k] == r2[k]);  // bit for bit
+  // The segment sum adds each receiver's rows in increasing source order, as a serial loop.
+  const int64_t R = 2000, N = 30000, C = 16;
+  const Tensord x = randn({N, C}, 41);
+  const ag::Index idx = rand_index(N, R, 44);
+  std::vector<double> ref(static_cast<size_t>(R * C), 0.0);
+  for (int64_t i = 0; i < N; ++i)
+    for (int64_t j = 0; j < C; ++j) ref[idx[i] * C + j] += x.data()[i * C + j];
+  CHECK(r1[0] == ref);
 }

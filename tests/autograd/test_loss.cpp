@@ -1,5 +1,5 @@
 // Gradient checks of the losses.
-#include "ag_test_util.hpp"
+#include "tests/support/ag_test_util.hpp"
 
 using namespace agt;
 
@@ -13,10 +13,12 @@ TEST_CASE("loss: l1 and mse, gradients w.r.t. prediction and target") {
   check_grad("mse_loss", kTol, [](auto& in) { return ag::mse_loss(in[0], in[1]); }, {p, t});
   for (double s : {1e-3, 1e3}) {
     INFO("scale " << s);
-    check_grad("mse scaled", kTol, [](auto& in) { return ag::mse_loss(in[0], in[1]); },
-               {randn({6, 3}, 3, s), randn({6, 3}, 4, s)}, step_for_scale(s));
-    check_grad("l1 scaled", kTol, [](auto& in) { return ag::l1_loss(in[0], in[1]); },
-               {randn({6, 3}, 5, s), randn({6, 3}, 6, s)}, step_for_scale(s));
+    check_grad(
+        "mse scaled", kTol, [](auto& in) { return ag::mse_loss(in[0], in[1]); },
+        {randn({6, 3}, 3, s), randn({6, 3}, 4, s)}, step_for_scale(s));
+    check_grad(
+        "l1 scaled", kTol, [](auto& in) { return ag::l1_loss(in[0], in[1]); },
+        {randn({6, 3}, 5, s), randn({6, 3}, 6, s)}, step_for_scale(s));
   }
 }
 

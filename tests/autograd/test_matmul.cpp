@@ -1,5 +1,5 @@
 // Gradient checks of matmul, linear and transpose (real and complex).
-#include "ag_test_util.hpp"
+#include "tests/support/ag_test_util.hpp"
 
 using namespace agt;
 using ag::Tensorcd;
@@ -30,8 +30,9 @@ TEST_CASE("linear: with and without bias, scaled inputs") {
   check_grad("linear", kTol, [](auto& in) { return ag::linear(in[0], in[1], Tensord()); }, {x, w});
   for (double s : {1e-3, 1e3}) {
     INFO("scale " << s);
-    check_grad("linear scaled", kTol, [](auto& in) { return ag::linear(in[0], in[1], in[2]); },
-               {randn({6, 4}, 6, s), randn({3, 4}, 7, s), randn({1, 3}, 8, s)}, step_for_multilinear());
+    check_grad(
+        "linear scaled", kTol, [](auto& in) { return ag::linear(in[0], in[1], in[2]); },
+        {randn({6, 4}, 6, s), randn({3, 4}, 7, s), randn({1, 3}, 8, s)}, step_for_multilinear());
   }
   const Tensord y = ag::linear(x, w, b);
   const Eigen::MatrixXd e = (x.mat() * w.mat().transpose()).rowwise() + b.mat().row(0);
@@ -47,20 +48,17 @@ TEST_CASE("transpose: gradient and value") {
 }
 
 TEST_CASE("matmul, linear, transpose: complex") {
-  const Tensord ar = randn({4, 3}, 11), ai = randn({4, 3}, 12), br = randn({3, 5}, 13),
-                bi = randn({3, 5}, 14), cr = randn({1, 5}, 15), ci = randn({1, 5}, 16);
-  check_grad("complex matmul", kTol,
-             [](auto& in) { return split(ag::matmul(cplx(in[0], in[1]), cplx(in[2], in[3]))); },
+  const Tensord ar = randn({4, 3}, 11), ai = randn({4, 3}, 12), br = randn({3, 5}, 13), bi = randn({3, 5}, 14),
+                cr = randn({1, 5}, 15), ci = randn({1, 5}, 16);
+  check_grad("complex matmul", kTol, [](auto& in) { return split(ag::matmul(cplx(in[0], in[1]), cplx(in[2], in[3]))); },
              {ar, ai, br, bi});
   // linear: x [4 x 3], weight [5 x 3] = transpose of b
   check_grad("complex linear", kTol,
              [](auto& in) {
-               return split(ag::linear(cplx(in[0], in[1]), ag::transpose(cplx(in[2], in[3])),
-                                       cplx(in[4], in[5])));
+               return split(ag::linear(cplx(in[0], in[1]), ag::transpose(cplx(in[2], in[3])), cplx(in[4], in[5])));
              },
              {ar, ai, br, bi, cr, ci});
-  check_grad("complex transpose", kTol,
-             [](auto& in) { return split(ag::transpose(cplx(in[0], in[1]))); }, {ar, ai});
+  check_grad("complex transpose", kTol, [](auto& in) { return split(ag::transpose(cplx(in[0], in[1]))); }, {ar, ai});
 }
 
 TEST_CASE("matmul, linear: float32 matches float64 within 1e-5") {
@@ -69,4 +67,28 @@ TEST_CASE("matmul, linear: float32 matches float64 within 1e-5") {
   const auto s = ag::linear(to_float(x), to_float(w), to_float(b));
   CHECK(max_abs_diff(s, d) < 1e-5);
   CHECK(max_abs_diff(ag::matmul(to_float(x), ag::transpose(to_float(w))), ag::matmul(x, ag::transpose(w))) < 1e-5);
+}
+
+TEST_CASE("linear_leaky_relu: gradient, and equal to leaky_relu(linear) bit for bit") {
+  const Tensord x = randn({7, 5}, 11), w = randn({4, 5}, 12), b = randn({1, 4}, 13);
+  const Tensord pre = ag::linear(x, w, b);
+  REQUIRE(pre.mat().cwiseAbs().minCoeff() > 1e-3);  // finite differences stay off the kink
+  check_grad("linear_leaky_relu+bias", kTol, [](auto& in) { return ag::linear_leaky_relu(in[0], in[1], in[2], 0.02); },
+             {x, w, b});
+  check_grad("linear_leaky_relu", kTol, [](auto& in) { return ag::linear_leaky_relu(in[0], in[1], Tensord(), 0.3); },
+             {x, w});
+  // float32, large enough for the parallel path: same values and gradients as the two ops
+  const Tensorf xf = to_float(randn({3000, 64}, 14)), wf = to_float(randn({48, 64}, 15, 0.2)),
+                bf = to_float(randn({1, 48}, 16)), cf = to_float(randn({3000, 48}, 17));
+  auto run = [&](bool fused) {
+    Tensorf xl = xf.detach().set_requires_grad(true), wl = wf.detach().set_requires_grad(true),
+            bl = bf.detach().set_requires_grad(true);
+    const Tensorf y = fused ? ag::linear_leaky_relu(xl, wl, bl, 0.02f) : ag::leaky_relu(ag::linear(xl, wl, bl), 0.02f);
+    ag::sum(ag::mul(y, cf)).backward();
+    return std::vector<std::vector<float>>{y.values(), xl.grad(), wl.grad(), bl.grad()};
+  };
+  const auto f = run(true), u = run(false);
+  for (size_t k = 0; k < f.size(); ++k) CHECK(f[k] == u[k]);
+  CHECK_THROWS_WITH_AS(ag::linear_leaky_relu(x, w, b, 0.0), doctest::Contains("linear_leaky_relu"), ag::Error);
+  CHECK_THROWS_WITH_AS(ag::linear_leaky_relu(x, randn({4, 3}, 18), b, 0.1), doctest::Contains("[7 x 5]"), ag::Error);
 }

@@ -1,5 +1,5 @@
 // Gradient checks of channel_norm and layer_norm, including equal rows.
-#include "ag_test_util.hpp"
+#include "tests/support/ag_test_util.hpp"
 
 using namespace agt;
 
@@ -14,8 +14,12 @@ TEST_CASE("norm: channel_norm and layer_norm on random inputs") {
   for (double s : {1e-3, 1e3}) {
     INFO("scale " << s);
     // eps = 1e-5 against a variance of ~1e-6 at scale 1e-3: still a smooth function.
-    check_grad("channel_norm scaled", kTol, [](auto& in) { return ag::channel_norm(in[0]); }, {randn({7, 4}, 2, s)}, step_for_scale(s));
-    check_grad("layer_norm scaled", kTol, [](auto& in) { return ag::layer_norm(in[0]); }, {randn({7, 4}, 3, s)}, step_for_scale(s));
+    check_grad(
+        "channel_norm scaled", kTol, [](auto& in) { return ag::channel_norm(in[0]); }, {randn({7, 4}, 2, s)},
+        step_for_scale(s));
+    check_grad(
+        "layer_norm scaled", kTol, [](auto& in) { return ag::layer_norm(in[0]); }, {randn({7, 4}, 3, s)},
+        step_for_scale(s));
   }
 }
 
@@ -60,7 +64,8 @@ TEST_CASE("norm: large channel_norm is deterministic and matches a direct comput
   const Eigen::RowVectorXd var = (m.rowwise() - mu).array().square().colwise().mean();
   double err = 0;
   for (int64_t r = 0; r < 20000; r += 997)
-    for (int j = 0; j < 16; ++j) err = std::max(err, std::abs(a.at(r, j) - (m(r, j) - mu(j)) / std::sqrt(var(j) + 1e-5)));
+    for (int j = 0; j < 16; ++j)
+      err = std::max(err, std::abs(a.at(r, j) - (m(r, j) - mu(j)) / std::sqrt(var(j) + 1e-5)));
   CHECK(err < 1e-12);
 }
 

@@ -1,5 +1,5 @@
 // Gradient checks of concat, slice and reshape.
-#include "ag_test_util.hpp"
+#include "tests/support/ag_test_util.hpp"
 
 using namespace agt;
 

@@ -1,5 +1,5 @@
 // Gradient checks of the row-wise vector ops, including zero vectors and scaled inputs.
-#include "ag_test_util.hpp"
+#include "tests/support/ag_test_util.hpp"
 
 #include <Eigen/Geometry>
 
@@ -46,11 +46,10 @@ TEST_CASE("vec3: zero vectors through norm_rows and normalize_rows") {
   // Step 1e-14 keeps x +- h inside the |x| < eps branch. Tolerance 1e-6 still holds.
   ag::GradCheckOptions opt;
   opt.step = 1e-14;
-  check_grad("normalize_rows zero row", kTol,
-             [](auto& in) { return ag::normalize_rows(in[0], 1e-6); },
-             {Tensord::zeros({2, 3})}, opt);
-  check_grad("norm_rows of cross3", kTol,
-             [](auto& in) { return ag::norm_rows(ag::cross3(in[0], in[1])); },
+  check_grad(
+      "normalize_rows zero row", kTol, [](auto& in) { return ag::normalize_rows(in[0], 1e-6); },
+      {Tensord::zeros({2, 3})}, opt);
+  check_grad("norm_rows of cross3", kTol, [](auto& in) { return ag::norm_rows(ag::cross3(in[0], in[1])); },
              {randn({4, 3}, 6), randn({4, 3}, 7)});
 }
 
@@ -59,10 +58,14 @@ TEST_CASE("vec3: inputs scaled by 1e-3 and 1e3") {
     INFO("scale " << s);
     const ag::GradCheckOptions opt = step_for_scale(s);
     const Tensord a = randn({5, 3}, 8, s), b = randn({5, 3}, 9, s);
-    check_grad("dot scaled", kTol, [](auto& in) { return ag::dot_rows(in[0], in[1]); }, {a, b}, opt);
-    check_grad("cross scaled", kTol, [](auto& in) { return ag::cross3(in[0], in[1]); }, {a, b}, opt);
-    check_grad("norm scaled", kTol, [](auto& in) { return ag::norm_rows(in[0]); }, {a}, opt);
-    check_grad("normalize scaled", kTol, [](auto& in) { return ag::normalize_rows(in[0]); }, {a}, opt);
+    check_grad(
+        "dot scaled", kTol, [](auto& in) { return ag::dot_rows(in[0], in[1]); }, {a, b}, opt);
+    check_grad(
+        "cross scaled", kTol, [](auto& in) { return ag::cross3(in[0], in[1]); }, {a, b}, opt);
+    check_grad(
+        "norm scaled", kTol, [](auto& in) { return ag::norm_rows(in[0]); }, {a}, opt);
+    check_grad(
+        "normalize scaled", kTol, [](auto& in) { return ag::normalize_rows(in[0]); }, {a}, opt);
   }
   // mm vs m: normalize is scale invariant
   const Tensord a = randn({5, 3}, 10);

@@ -1,5 +1,5 @@
 // Gradient checks of the fused WIRE activation, including large arguments.
-#include "ag_test_util.hpp"
+#include "tests/support/ag_test_util.hpp"
 
 using namespace agt;
 using ag::Tensorcd;

@@ -14,8 +14,8 @@ const double kC[3] = {1.0, -2.0, 0.5};
 double scale_at(int t) { return std::pow(0.3, t); }
 
 // Reference, written out with scalars, following the PyTorch documentation's algorithm.
-std::vector<std::vector<double>> reference(std::vector<double> p, int steps, double lr, double b1, double b2, double eps,
-                                           double wd, bool amsgrad) {
+std::vector<std::vector<double>> reference(std::vector<double> p, int steps, double lr, double b1, double b2,
+                                           double eps, double wd, bool amsgrad) {
   std::vector<double> m(3, 0.0), v(3, 0.0), vhat(3, 0.0);
   std::vector<std::vector<double>> hist;
   for (int t = 1; t <= steps; ++t) {

@@ -112,7 +112,8 @@ TEST_CASE("checkpoint: a flipped byte, truncation or trailing bytes are refused 
   longer.push_back(0);
   write_all(bad, longer);
   CHECK_THROWS_WITH_AS(nn::read_checkpoint(bad), doctest::Contains("trailing"), ag::Error);
-  CHECK_THROWS_WITH_AS(nn::read_checkpoint(tmp_path("does_not_exist.ckpt")), doctest::Contains("does_not_exist"), ag::Error);
+  CHECK_THROWS_WITH_AS(nn::read_checkpoint(tmp_path("does_not_exist.ckpt")), doctest::Contains("does_not_exist"),
+                       ag::Error);
   // The model is untouched by refused loads.
   nn::Rng rng2(3);
   nn::MLPStack<double> same({2, 5, 2}, false, false, rng2);
@@ -126,11 +127,13 @@ TEST_CASE("checkpoint: name, shape, dtype and optimizer mismatches are refused")
   nn::save_checkpoint<float>(path, net, nullptr, 0, "{}");
 
   nn::MLPStack<float> wider({2, 6, 2}, false, false, rng);
-  CHECK_THROWS_WITH_AS(nn::load_checkpoint<float>(path, wider, nullptr), doctest::Contains("0.linear1.weight"), ag::Error);
+  CHECK_THROWS_WITH_AS(nn::load_checkpoint<float>(path, wider, nullptr), doctest::Contains("0.linear1.weight"),
+                       ag::Error);
   nn::MLPStack<float> deeper({2, 5, 2, 2}, false, false, rng);
   CHECK_THROWS_WITH_AS(nn::load_checkpoint<float>(path, deeper, nullptr), doctest::Contains("missing"), ag::Error);
   nn::MLPStack<float> shallower({2, 5}, false, false, rng);
-  CHECK_THROWS_WITH_AS(nn::load_checkpoint<float>(path, shallower, nullptr), doctest::Contains("not in the model"), ag::Error);
+  CHECK_THROWS_WITH_AS(nn::load_checkpoint<float>(path, shallower, nullptr), doctest::Contains("not in the model"),
+                       ag::Error);
   nn::MLPStack<double> dbl({2, 5, 2}, false, false, rng);
   CHECK_THROWS_WITH_AS(nn::load_checkpoint<double>(path, dbl, nullptr), doctest::Contains("float32"), ag::Error);
   nn::AdamW<float> opt(net.named_parameters());

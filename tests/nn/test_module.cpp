@@ -15,7 +15,8 @@ struct Net : nn::Module<double> {
   std::shared_ptr<nn::Linear<double>> head;
   ag::Tensord gain;
   Net(nn::Rng& rng) {
-    enc = register_module("encoder", std::make_shared<nn::MLPStack<double>>(std::vector<int64_t>{4, 6, 5}, true, true, rng));
+    enc = register_module("encoder",
+                          std::make_shared<nn::MLPStack<double>>(std::vector<int64_t>{4, 6, 5}, true, true, rng));
     head = register_module("head", std::make_shared<nn::Linear<double>>(5, 2, false, rng));
     gain = register_parameter("gain", ag::Tensord::full({1, 2}, 1.0));
   }
@@ -34,12 +35,20 @@ TEST_CASE("Module: dotted names in registration order, counts, zero_grad, duplic
     names.push_back(n);
     CHECK(t.requires_grad());
   }
-  const std::vector<std::string> expected = {
-      "encoder.0.linear1.weight", "encoder.0.linear1.bias", "encoder.0.linear2.weight", "encoder.0.linear2.bias",
-      "encoder.0.scale", "encoder.0.shift",
-      "encoder.1.linear1.weight", "encoder.1.linear1.bias", "encoder.1.linear2.weight", "encoder.1.linear2.bias",
-      "encoder.1.scale", "encoder.1.shift",
-      "head.weight", "gain"};
+  const std::vector<std::string> expected = {"encoder.0.linear1.weight",
+                                             "encoder.0.linear1.bias",
+                                             "encoder.0.linear2.weight",
+                                             "encoder.0.linear2.bias",
+                                             "encoder.0.scale",
+                                             "encoder.0.shift",
+                                             "encoder.1.linear1.weight",
+                                             "encoder.1.linear1.bias",
+                                             "encoder.1.linear2.weight",
+                                             "encoder.1.linear2.bias",
+                                             "encoder.1.scale",
+                                             "encoder.1.shift",
+                                             "head.weight",
+                                             "gain"};
   CHECK(names == expected);
   const int64_t count = 2 + (4 * 6 + 6 + 36 + 6 + 12) + (6 * 5 + 5 + 25 + 5 + 10) + 10;
   CHECK(net.num_parameters() == count);
@@ -115,14 +124,16 @@ TEST_CASE("MLPBlock: forward matches its definition; float64 gradient check with
 
   // Reference with Eigen.
   auto lrelu = [](Eigen::MatrixXd m) { return m.unaryExpr([](double v) { return v > 0 ? v : 0.02 * v; }).eval(); };
-  Eigen::MatrixXd h = lrelu((x.mat() * blk.linear1->weight.mat().transpose()).rowwise() + blk.linear1->bias.mat().row(0));
+  Eigen::MatrixXd h =
+      lrelu((x.mat() * blk.linear1->weight.mat().transpose()).rowwise() + blk.linear1->bias.mat().row(0));
   h = (h * blk.linear2->weight.mat().transpose()).rowwise() + blk.linear2->bias.mat().row(0);
   for (int c = 0; c < h.cols(); ++c) {
     const double mu = h.col(c).mean();
     const double var = (h.col(c).array() - mu).square().mean();
     h.col(c) = (h.col(c).array() - mu) / std::sqrt(var + 1e-5);
   }
-  for (int c = 0; c < h.cols(); ++c) h.col(c) = h.col(c) * (1 + blk.scale.values()[c]) + Eigen::VectorXd::Constant(h.rows(), blk.shift.values()[c]);
+  for (int c = 0; c < h.cols(); ++c)
+    h.col(c) = h.col(c) * (1 + blk.scale.values()[c]) + Eigen::VectorXd::Constant(h.rows(), blk.shift.values()[c]);
   h = lrelu(h);
   CHECK((blk.forward(x).mat() - h).cwiseAbs().maxCoeff() < 1e-12);
 

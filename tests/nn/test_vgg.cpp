@@ -2,11 +2,11 @@
 // independent conv/pool implementation) on the same weights and input, the OpenCV file
 // loader (for a user's full VGG19), gradients to the image, and the feature losses.
 #include "autograd/autograd.hpp"
-#include "nn/caffe_export.hpp"
+#include "tests/support/caffe_export.hpp"
 #include "nn/feature_loss.hpp"
 #include "nn/rng.hpp"
 #include "nn/vgg.hpp"
-#include "nn/vgg_opencv.hpp"
+#include "tests/support/vgg_opencv.hpp"
 
 #include <doctest/doctest.h>
 #include <opencv2/dnn.hpp>
@@ -147,10 +147,12 @@ TEST_CASE("VGG19: the shared ImageNet weights load with their documented statist
 
 TEST_CASE("VGG19: missing weights give a clear error naming the path") {
   const std::string missing = tmp_path("no_such_vgg_dir");
-  CHECK_THROWS_WITH_AS(nn::load_vgg19_keras(missing), doctest::Contains(doctest::String((missing + "/model.json").c_str())), ag::Error);
+  CHECK_THROWS_WITH_AS(nn::load_vgg19_keras(missing),
+                       doctest::Contains(doctest::String((missing + "/model.json").c_str())), ag::Error);
   CHECK_THROWS_WITH_AS(nn::VGG19Features<float>{missing}, doctest::Contains("not found"), ag::Error);
-  CHECK_THROWS_WITH_AS(nn::load_vgg19_opencv(missing + "/x.caffemodel", missing + "/x.prototxt", nn::VggPreprocess::CaffeBGR),
-                       doctest::Contains("x.caffemodel"), ag::Error);
+  CHECK_THROWS_WITH_AS(
+      nn::load_vgg19_opencv(missing + "/x.caffemodel", missing + "/x.prototxt", nn::VggPreprocess::CaffeBGR),
+      doctest::Contains("x.caffemodel"), ag::Error);
 }
 
 TEST_CASE("VGG19: our conv/pool forward matches OpenCV dnn on the shared weights (1e-4 relative)") {
@@ -165,8 +167,8 @@ TEST_CASE("VGG19: a full VGG19 read through OpenCV (Caffe files) gives relu1_2 .
   CHECK(err < 1e-4);
 
   // The loader path: the files written above, read back through cv::dnn.
-  const nn::VggWeights back =
-      nn::load_vgg19_opencv(tmp_path("vgg_narrow.caffemodel"), tmp_path("vgg_narrow.prototxt"), nn::VggPreprocess::TorchRGB);
+  const nn::VggWeights back = nn::load_vgg19_opencv(tmp_path("vgg_narrow.caffemodel"), tmp_path("vgg_narrow.prototxt"),
+                                                    nn::VggPreprocess::TorchRGB);
   REQUIRE(back.convs.size() == 16);
   for (int i = 0; i < 16; ++i) {
     CHECK(back.convs[i].weight == w.convs[i].weight);
@@ -184,7 +186,8 @@ TEST_CASE("VGG19: the shared weights survive the Caffe/OpenCV loader bit-exactly
   nn::write_vgg_caffe(w, proto, model, 32, 32);
   const nn::VggWeights back = nn::load_vgg19_opencv(model, proto, nn::VggPreprocess::CaffeBGR);
   REQUIRE(back.convs.size() == 8);
-  for (int i = 0; i < 8; ++i) CHECK(std::memcmp(back.convs[i].weight.data(), w.convs[i].weight.data(), 4 * w.convs[i].weight.size()) == 0);
+  for (int i = 0; i < 8; ++i)
+    CHECK(std::memcmp(back.convs[i].weight.data(), w.convs[i].weight.data(), 4 * w.convs[i].weight.size()) == 0);
 }
 
 TEST_CASE("VGG19: weights are frozen, gradients reach the image (float64 gradient check of the cosine loss)") {
@@ -195,9 +198,8 @@ TEST_CASE("VGG19: weights are frozen, gradients reach the image (float64 gradien
   ag::Tensord pred = random_image<double>(1, 6, 6, 12);
   // Tolerance 1e-6: the loss is smooth except at ReLU kinks; this fixed input keeps every
   // pre-activation far from 0 relative to the step.
-  const auto r = ag::gradcheck(
-      [&](const std::vector<ag::Tensord>& in) { return nn::vgg_loss(vgg, in[0], target); }, {pred},
-      ag::GradCheckOptions{});
+  const auto r = ag::gradcheck([&](const std::vector<ag::Tensord>& in) { return nn::vgg_loss(vgg, in[0], target); },
+                               {pred}, ag::GradCheckOptions{});
   CHECK_MESSAGE(r.max_rel_error < 1e-6, r.report());
 
   pred.set_requires_grad(true);
@@ -229,8 +231,8 @@ TEST_CASE("cosine_distance_channels: value, float64 gradient check for both inpu
       sum += ab / std::sqrt(aa * bb);
     }
   CHECK(nn::cosine_distance_channels(a, b).item() == doctest::Approx(1.0 - sum / 24).epsilon(1e-13));
-  const auto r = ag::gradcheck([](const std::vector<ag::Tensord>& in) { return nn::cosine_distance_channels(in[0], in[1]); },
-                               {a, b});
+  const auto r = ag::gradcheck(
+      [](const std::vector<ag::Tensord>& in) { return nn::cosine_distance_channels(in[0], in[1]); }, {a, b});
   // Tolerance 1e-5: the loss is a mean of 24 cosines of O(1); entries whose gradient is ~1e-4
   // of the largest carry central-difference round-off (~1e-10 absolute) of that order.
   CHECK_MESSAGE(r.max_rel_error < 1e-5, r.report());
@@ -239,9 +241,9 @@ TEST_CASE("cosine_distance_channels: value, float64 gradient check for both inpu
     ag::GradCheckOptions o;
     o.step = 1e-6 * std::min(1.0, s);
     const ag::Tensord other = rnd({1, 3, 2, 2});
-    const auto rs = ag::gradcheck(
-        [&](const std::vector<ag::Tensord>& in) { return nn::cosine_distance_channels(in[0], other); },
-        {ag::mul_scalar(rnd({1, 3, 2, 2}), s).detach()}, o);
+    const auto rs =
+        ag::gradcheck([&](const std::vector<ag::Tensord>& in) { return nn::cosine_distance_channels(in[0], other); },
+                      {ag::mul_scalar(rnd({1, 3, 2, 2}), s).detach()}, o);
     CHECK_MESSAGE(rs.max_rel_error < 1e-5, "scale " << s << ": " << rs.report());
   }
 

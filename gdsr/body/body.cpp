@@ -1,0 +1,579 @@
+#include "gdsr/body/body.hpp"
+
+#include "gdsr/error.hpp"
+
+#include "gdsr/body/skeleton_body.hpp"
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <stdexcept>
+
+namespace gdsr {
+namespace {
+
+using Mat4 = Eigen::Matrix4d;
+using Quat = Eigen::Quaterniond;
+
+Mat4 to_eigen(const aiMatrix4x4& m) {
+  Mat4 r;
+  r << m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4, m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3, m.d4;
+  return r;
+}
+
+struct Trs {
+  Vec3 t = Vec3::Zero();
+  Quat r = Quat::Identity();
+  Vec3 s = Vec3::Ones();
+  Mat4 matrix() const {
+    Mat4 m = Mat4::Identity();
+    m.topLeftCorner<3, 3>() = r.toRotationMatrix() * s.asDiagonal();
+    m.topRightCorner<3, 1>() = t;
+    return m;
+  }
+};
+
+Trs decompose(const aiMatrix4x4& m) {
+  aiVector3D s, p;
+  aiQuaternion q;
+  m.Decompose(s, q, p);
+  Trs r;
+  r.t = Vec3(p.x, p.y, p.z);
+  r.r = Quat(q.w, q.x, q.y, q.z).normalized();
+  r.s = Vec3(s.x, s.y, s.z);
+  return r;
+}
+
+template <class Key> int bracket(const Key* keys, unsigned n, double tick) {  // last key with time <= tick
+  if (n == 0 || tick <= keys[0].mTime) return 0;
+  int lo = 0, hi = static_cast<int>(n) - 1;
+  if (tick >= keys[hi].mTime) return hi;
+  while (hi - lo > 1) {
+    const int mid = (lo + hi) / 2;
+    (keys[mid].mTime <= tick ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+template <class Key> double frac(const Key* keys, unsigned n, int i, double tick) {
+  if (i + 1 >= static_cast<int>(n)) return 0;
+  const double dt = keys[i + 1].mTime - keys[i].mTime;
+  return dt > 0 ? std::clamp((tick - keys[i].mTime) / dt, 0.0, 1.0) : 0.0;
+}
+
+Trs sample(const aiNodeAnim* ch, double tick, const Trs& rest) {
+  Trs r = rest;
+  if (ch->mNumPositionKeys > 0) {
+    const int i = bracket(ch->mPositionKeys, ch->mNumPositionKeys, tick);
+    const double a = frac(ch->mPositionKeys, ch->mNumPositionKeys, i, tick);
+    const auto& k0 = ch->mPositionKeys[i].mValue;
+    const auto& k1 = ch->mPositionKeys[std::min<int>(i + 1, ch->mNumPositionKeys - 1)].mValue;
+    r.t = (1 - a) * Vec3(k0.x, k0.y, k0.z) + a * Vec3(k1.x, k1.y, k1.z);
+  }
+  if (ch->mNumRotationKeys > 0) {
+    const int i = bracket(ch->mRotationKeys, ch->mNumRotationKeys, tick);
+    const double a = frac(ch->mRotationKeys, ch->mNumRotationKeys, i, tick);
+    const auto& k0 = ch->mRotationKeys[i].mValue;
+    const auto& k1 = ch->mRotationKeys[std::min<int>(i + 1, ch->mNumRotationKeys - 1)].mValue;
+    const Quat q0(k0.w, k0.x, k0.y, k0.z), q1(k1.w, k1.x, k1.y, k1.z);
+    r.r = q0.normalized().slerp(a, q1.normalized());
+  }
+  if (ch->mNumScalingKeys > 0) {
+    const int i = bracket(ch->mScalingKeys, ch->mNumScalingKeys, tick);
+    const double a = frac(ch->mScalingKeys, ch->mNumScalingKeys, i, tick);
+    const auto& k0 = ch->mScalingKeys[i].mValue;
+    const auto& k1 = ch->mScalingKeys[std::min<int>(i + 1, ch->mNumScalingKeys - 1)].mValue;
+    r.s = (1 - a) * Vec3(k0.x, k0.y, k0.z) + a * Vec3(k1.x, k1.y, k1.z);
+  }
+  return r;
+}
+
+// Scene nodes in parent-before-child order with their rest transforms and channels.
+struct Rig {
+  std::vector<const aiNode*> node;
+  std::vector<int> parent;
+  std::vector<Trs> rest;
+  std::vector<const aiNodeAnim*> channel;
+  std::map<std::string, int> index;
+  Mat4 pre = Mat4::Identity();  // up-axis fix applied above the root
+
+  // Global transforms for the given local transforms.
+  std::vector<Mat4> globals(const std::vector<Trs>& local) const {
+    std::vector<Mat4> G(node.size());
+    for (size_t i = 0; i < node.size(); ++i) G[i] = (parent[i] < 0 ? pre : G[parent[i]]) * local[i].matrix();
+    return G;
+  }
+};
+
+Mat4 up_axis_fix(const aiScene* s) {
+  Mat4 m = Mat4::Identity();
+  if (!s->mMetaData) return m;
+  int up = 1, sign = 1;
+  if (!s->mMetaData->Get("UpAxis", up)) return m;
+  s->mMetaData->Get("UpAxisSign", sign);
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  if (up == 2)
+    R = Eigen::AngleAxisd(-M_PI / 2, Vec3::UnitX()).toRotationMatrix();
+  else if (up == 0)
+    R = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()).toRotationMatrix();
+  if (sign < 0) R = Eigen::AngleAxisd(M_PI, Vec3::UnitX()).toRotationMatrix() * R;
+  m.topLeftCorner<3, 3>() = R;
+  return m;
+}
+
+// Skinning: vertex v = sum_k w_k * (G[node_k] * bind_k) * p_v (p in the bind space).
+struct Skin {
+  Points3 P;                    // bind-space positions
+  std::vector<int> start, mat;  // per vertex influences into mats
+  std::vector<double> weight;
+  std::vector<int> mat_node;   // matrix -> node
+  std::vector<Mat4> mat_bind;  // matrix -> bind (offset) matrix
+  Faces F;
+
+  Points3 apply(const std::vector<Mat4>& G) const {
+    std::vector<Mat4> M(mat_node.size());
+    for (size_t m = 0; m < M.size(); ++m) M[m] = G[mat_node[m]] * mat_bind[m];
+    Points3 out(P.rows(), 3);
+    for (Eigen::Index i = 0; i < P.rows(); ++i) {
+      Eigen::Vector4d p(P(i, 0), P(i, 1), P(i, 2), 1.0), acc = Eigen::Vector4d::Zero();
+      for (int k = start[i]; k < start[i + 1]; ++k) acc += weight[k] * (M[mat[k]] * p);
+      out.row(i) = acc.head<3>().transpose();
+    }
+    return out;
+  }
+};
+
+void collect(const aiNode* n, int parent, Rig& rig) {
+  const int id = static_cast<int>(rig.node.size());
+  rig.node.push_back(n);
+  rig.parent.push_back(parent);
+  rig.rest.push_back(decompose(n->mTransformation));
+  rig.channel.push_back(nullptr);
+  rig.index[n->mName.C_Str()] = id;
+  for (unsigned c = 0; c < n->mNumChildren; ++c) collect(n->mChildren[c], id, rig);
+}
+
+// Skinned meshes of the file (all meshes; meshes without bones follow their node).
+Skin skin_from_meshes(const aiScene* s, const Rig& rig, const std::string& path) {
+  Skin sk;
+  std::vector<Vec3> P;
+  std::vector<std::vector<std::pair<int, double>>> infl;
+  std::vector<Eigen::Vector3i> tris;
+  std::map<std::string, int> bone_mat;
+  for (size_t ni = 0; ni < rig.node.size(); ++ni) {
+    const aiNode* nd = rig.node[ni];
+    for (unsigned mi = 0; mi < nd->mNumMeshes; ++mi) {
+      const aiMesh* m = s->mMeshes[nd->mMeshes[mi]];
+      const int base = static_cast<int>(P.size());
+      for (unsigned v = 0; v < m->mNumVertices; ++v)
+        P.emplace_back(m->mVertices[v].x, m->mVertices[v].y, m->mVertices[v].z);
+      infl.resize(P.size());
+      for (unsigned b = 0; b < m->mNumBones; ++b) {
+        const aiBone* bone = m->mBones[b];
+        auto it = rig.index.find(bone->mName.C_Str());
+        if (it == rig.index.end())
+          gdsr::fail("load_body_sequence: " + path, std::string("bone '") + bone->mName.C_Str() + "' has no node");
+        const int mat = static_cast<int>(sk.mat_node.size());
+        sk.mat_node.push_back(it->second);
+        sk.mat_bind.push_back(to_eigen(bone->mOffsetMatrix));
+        for (unsigned w = 0; w < bone->mNumWeights; ++w)
+          if (bone->mWeights[w].mWeight > 0)
+            infl[base + bone->mWeights[w].mVertexId].push_back({mat, bone->mWeights[w].mWeight});
+      }
+      // Vertices without weights follow the mesh's node rigidly.
+      const int rigid = static_cast<int>(sk.mat_node.size());
+      sk.mat_node.push_back(static_cast<int>(ni));
+      sk.mat_bind.push_back(Mat4::Identity());
+      for (unsigned v = 0; v < m->mNumVertices; ++v)
+        if (infl[base + v].empty()) infl[base + v].push_back({rigid, 1.0});
+      for (unsigned f = 0; f < m->mNumFaces; ++f)
+        if (m->mFaces[f].mNumIndices == 3)
+          tris.emplace_back(base + m->mFaces[f].mIndices[0], base + m->mFaces[f].mIndices[1],
+                            base + m->mFaces[f].mIndices[2]);
+    }
+  }
+  if (tris.empty()) gdsr::fail("load_body_sequence: " + path, "skinned mesh has no triangles");
+  sk.P.resize(P.size(), 3);
+  sk.start.push_back(0);
+  for (size_t i = 0; i < P.size(); ++i) {
+    sk.P.row(i) = P[i].transpose();
+    double tot = 0;
+    for (auto& [m, w] : infl[i]) tot += w;
+    for (auto& [m, w] : infl[i]) sk.mat.push_back(m), sk.weight.push_back(w / tot);
+    sk.start.push_back(static_cast<int>(sk.mat.size()));
+  }
+  sk.F.resize(tris.size(), 3);
+  for (size_t f = 0; f < tris.size(); ++f) sk.F.row(f) = tris[f].transpose();
+  return sk;
+}
+
+// Welds vertices with identical rest positions (mesh seams split by normals/UVs).
+void weld(Skin& sk, const Points3& rest) {
+  std::map<std::array<double, 3>, int> seen;
+  std::vector<int> remap(rest.rows());
+  std::vector<int> keep;
+  for (Eigen::Index i = 0; i < rest.rows(); ++i) {
+    std::array<double, 3> key{std::round(rest(i, 0) * 1e6), std::round(rest(i, 1) * 1e6), std::round(rest(i, 2) * 1e6)};
+    auto [it, fresh] = seen.emplace(key, static_cast<int>(keep.size()));
+    if (fresh) keep.push_back(static_cast<int>(i));
+    remap[i] = it->second;
+  }
+  Skin w;
+  w.mat_node = sk.mat_node;
+  w.mat_bind = sk.mat_bind;
+  w.P.resize(keep.size(), 3);
+  w.start.push_back(0);
+  for (size_t j = 0; j < keep.size(); ++j) {
+    const int i = keep[j];
+    w.P.row(j) = sk.P.row(i);
+    for (int k = sk.start[i]; k < sk.start[i + 1]; ++k) w.mat.push_back(sk.mat[k]), w.weight.push_back(sk.weight[k]);
+    w.start.push_back(static_cast<int>(w.mat.size()));
+  }
+  std::vector<Eigen::Vector3i> tris;
+  for (Eigen::Index f = 0; f < sk.F.rows(); ++f) {
+    Eigen::Vector3i t(remap[sk.F(f, 0)], remap[sk.F(f, 1)], remap[sk.F(f, 2)]);
+    if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) tris.push_back(t);
+  }
+  w.F.resize(tris.size(), 3);
+  for (size_t f = 0; f < tris.size(); ++f) w.F.row(f) = tris[f].transpose();
+  sk = std::move(w);
+}
+
+double smoothstep(double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return x * x * (3 - 2 * x);
+}
+
+// The file's animation (the one with most channels) and its rig (nodes, rest, channels).
+struct Clip {
+  const aiAnimation* anim = nullptr;
+  Rig rig;
+  double tps = 25;      // ticks per second
+  double t0 = 0;        // clip start, seconds (after a skipped calibration key)
+  double duration = 0;  // seconds from t0
+  bool skinned = false;
+};
+
+Clip read_clip(const aiScene* s, const std::string& path, const BodyOptions& opt) {
+  if (s->mNumAnimations == 0) gdsr::fail("load_body_sequence: " + path, "file has no animation");
+  Clip c;
+  c.anim = s->mAnimations[0];
+  for (unsigned a = 1; a < s->mNumAnimations; ++a)
+    if (s->mAnimations[a]->mNumChannels > c.anim->mNumChannels) c.anim = s->mAnimations[a];
+  if (c.anim->mNumChannels == 0) gdsr::fail("load_body_sequence: " + path, "animation has no channels");
+  collect(s->mRootNode, -1, c.rig);
+  c.rig.pre = up_axis_fix(s);
+  for (unsigned k = 0; k < c.anim->mNumChannels; ++k) {
+    auto it = c.rig.index.find(c.anim->mChannels[k]->mNodeName.C_Str());
+    if (it != c.rig.index.end()) c.rig.channel[it->second] = c.anim->mChannels[k];
+  }
+  std::string ext = path.substr(path.find_last_of('.') + 1);
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  if (ext != "bvh")
+    for (unsigned m = 0; m < s->mNumMeshes; ++m) c.skinned = c.skinned || s->mMeshes[m]->mNumBones > 0;
+
+  c.tps = c.anim->mTicksPerSecond > 0 ? c.anim->mTicksPerSecond : 25.0;
+  // Calibration key: largest per-channel rotation between keys 0-1 vs keys 1-2.
+  if (opt.skip_calibration_key) {
+    double j01 = 0, j12 = 0;
+    double t1 = -1;
+    for (size_t i = 0; i < c.rig.node.size(); ++i) {
+      const aiNodeAnim* ch = c.rig.channel[i];
+      if (!ch || ch->mNumRotationKeys < 3) continue;
+      auto q = [&](int k) {
+        const auto& v = ch->mRotationKeys[k].mValue;
+        return Quat(v.w, v.x, v.y, v.z).normalized();
+      };
+      j01 = std::max(j01, q(0).angularDistance(q(1)));
+      j12 = std::max(j12, q(1).angularDistance(q(2)));
+      t1 = ch->mRotationKeys[1].mTime / c.tps;
+    }
+    if (t1 > 0 && j01 > 20 * M_PI / 180 && j01 > 5 * j12) c.t0 = t1;
+  }
+  c.duration = c.anim->mDuration / c.tps - c.t0;
+  return c;
+}
+
+// Local transforms of every node at `seconds` into the clip.
+std::vector<Trs> pose_at(const Clip& c, double seconds) {
+  std::vector<Trs> L(c.rig.rest);
+  for (size_t i = 0; i < c.rig.node.size(); ++i)
+    if (c.rig.channel[i]) L[i] = sample(c.rig.channel[i], (c.t0 + seconds) * c.tps, c.rig.rest[i]);
+  return L;
+}
+
+// The body surface with its skin: the file's skinned meshes, or a body built around the
+// skeleton (sb, and shape_to_rest: the skeleton body's landmark space -> rest pose).
+struct Surface {
+  Skin sk;
+  detail::SkinnedBody sb;
+  Mat4 shape_to_rest = Mat4::Identity();
+};
+
+Surface build_surface(const aiScene* s, const Clip& c, const std::vector<Mat4>& G_rest, const std::string& path,
+                      const BodyOptions& opt) {
+  Surface out;
+  const Rig& rig = c.rig;
+  if (c.skinned) {
+    out.sk = skin_from_meshes(s, rig, path);
+    weld(out.sk, out.sk.apply(G_rest));
+    return out;
+  }
+  // Skeleton: every node below the top animated ancestor of the first animated node.
+  const size_t nn = rig.node.size();
+  int root = -1;
+  for (size_t i = 0; i < nn && root < 0; ++i)
+    if (rig.channel[i]) root = static_cast<int>(i);
+  if (root < 0) gdsr::fail("load_body_sequence: " + path, "no animated node (no skeleton)");
+  while (rig.parent[root] >= 0 && rig.channel[rig.parent[root]]) root = rig.parent[root];
+  // The body is built at the file's rest pose with its own root translation, so the same
+  // skeleton always gives the same mesh whatever start_seconds is.
+  const std::vector<Mat4> G_shape = rig.globals(rig.rest);
+  out.shape_to_rest = G_rest[root] * G_shape[root].inverse();
+  std::vector<detail::SkelNode> nodes;
+  std::vector<int> to_rig;
+  std::map<int, int> from_rig;
+  for (size_t i = root; i < nn; ++i) {
+    const int p = rig.parent[i];
+    if (static_cast<int>(i) != root && !from_rig.count(p)) continue;
+    from_rig[static_cast<int>(i)] = static_cast<int>(nodes.size());
+    to_rig.push_back(static_cast<int>(i));
+    detail::SkelNode sn;
+    sn.name = rig.node[i]->mName.C_Str();
+    sn.parent = static_cast<int>(i) == root ? -1 : from_rig[p];
+    sn.pos = G_shape[i].topRightCorner<3, 1>();
+    nodes.push_back(sn);
+  }
+  if (nodes.size() < 3) gdsr::fail("load_body_sequence: " + path, "skeleton has fewer than 3 joints");
+  double ymin = 1e300, ymax = -1e300;
+  for (auto& sn : nodes) ymin = std::min(ymin, sn.pos.y()), ymax = std::max(ymax, sn.pos.y());
+  if (!(ymax - ymin > 0)) gdsr::fail("load_body_sequence: " + path, "skeleton has zero height at the rest pose");
+  const double mpu = opt.height / ((ymax - ymin) * 1.04);
+  out.sb = detail::build_skeleton_body(nodes, mpu, opt.body_edge);
+  // Skin matrices: node k -> G(t) * G_rest^-1, bind space = rest world.
+  Skin& sk = out.sk;
+  sk.P = out.sb.V;
+  sk.F = out.sb.F;
+  sk.start = out.sb.skin_start;
+  for (size_t k = 0; k < nodes.size(); ++k) {
+    sk.mat_node.push_back(to_rig[k]);
+    sk.mat_bind.push_back(G_shape[to_rig[k]].inverse());
+  }
+  sk.mat = out.sb.skin_node;
+  sk.weight = out.sb.skin_weight;
+  return out;
+}
+
+// Similarity from file units to metres: the rest pose stands on y = 0, centred in x and z.
+struct ToMetres {
+  double scale = 1;
+  Vec3 shift = Vec3::Zero();
+  Points3 operator()(const Points3& X) const { return (X.rowwise() - shift.transpose()) * scale; }
+  Vec3 operator()(const Vec3& p) const { return (p - shift) * scale; }
+};
+
+ToMetres to_metres(const Points3& rest_raw, double height, double leg_extra, const std::string& path) {
+  if (!rest_raw.allFinite()) gdsr::fail("load_body_sequence: " + path, "rest pose has non-finite vertices");
+  const Vec3 lo = rest_raw.colwise().minCoeff(), hi = rest_raw.colwise().maxCoeff();
+  if (!(hi.y() - lo.y() > 0)) gdsr::fail("load_body_sequence: " + path, "body has zero height at the rest pose");
+  ToMetres m;
+  // Skeleton bodies: standing height counts the legs as vertical (rest poses may spread them).
+  m.scale = height / (hi.y() - lo.y() + leg_extra);
+  m.shift = Vec3(0.5 * (lo.x() + hi.x()), lo.y(), 0.5 * (lo.z() + hi.z()));
+  return m;
+}
+
+// Mirroring bind transforms flip triangles: make closed meshes enclose positive volume.
+void orient_outward(Faces& F, const Points3& V) {
+  double vol = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    vol += Vec3(V.row(F(f, 0))).dot(Vec3(V.row(F(f, 1))).cross(Vec3(V.row(F(f, 2)))));
+  if (vol < 0) F.col(1).swap(F.col(2));
+}
+
+// Body frames: `blend` frames from the rest pose into the first motion pose (smoothstep),
+// then n_motion frames of the clip at opt.fps from opt.start_seconds.
+std::vector<Points3> animate(const Clip& c, const Skin& sk, const ToMetres& to_out, const std::vector<Trs>& rest_local,
+                             const std::vector<Trs>& first, int blend, int n_motion, const BodyOptions& opt,
+                             const std::string& path) {
+  const size_t nn = c.rig.node.size();
+  std::vector<Points3> frames(blend + n_motion);
+  // Frames are independent: parallel over frames (skinning one frame is too small to split).
+  int bad_frame = -1;
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int f = 0; f < blend + n_motion; ++f) {
+    std::vector<Trs> L;
+    if (f < blend) {
+      const double a = smoothstep(static_cast<double>(f) / blend);
+      L = rest_local;
+      for (size_t i = 0; i < nn; ++i) {
+        L[i].t = (1 - a) * rest_local[i].t + a * first[i].t;
+        L[i].r = rest_local[i].r.slerp(a, first[i].r);
+        L[i].s = (1 - a) * rest_local[i].s + a * first[i].s;
+      }
+    } else {
+      const int k = f - blend;
+      L = k == 0 ? first : pose_at(c, opt.start_seconds + k / opt.fps);
+    }
+    frames[f] = to_out(sk.apply(c.rig.globals(L)));
+    if (!frames[f].allFinite()) {
+#pragma omp critical
+      bad_frame = f;
+    }
+  }
+  if (bad_frame >= 0)
+    gdsr::fail("load_body_sequence: " + path, "non-finite vertices at frame " + std::to_string(bad_frame));
+  return frames;
+}
+
+// Landmarks of the rest pose: hip, waist and chest sections, shoulder and crotch heights.
+// Skeleton bodies know where their trunk is; skinned meshes use fixed fractions of the height.
+BodyLandmarks measure_landmarks(const TriMesh& rest, const Surface& surf, const ToMetres& to_out, bool skinned,
+                                double height) {
+  BodyLandmarks lm;
+  lm.height = height;
+  const detail::SkinnedBody& sb = surf.sb;
+  auto out_pt = [&](const Vec3& p) { return to_out(Vec3((surf.shape_to_rest * p.homogeneous()).head<3>())); };
+  Vec3 hip_c, waist_c, chest_c;
+  if (!skinned) {
+    hip_c = out_pt(sb.hip_c), waist_c = out_pt(sb.waist_c), chest_c = out_pt(sb.chest_c);
+    lm.shoulder_y = out_pt(Vec3(sb.chest_c.x(), sb.shoulder_y, sb.chest_c.z())).y();
+  } else {
+    const double H = height;
+    hip_c = Vec3(0, 0.52 * H, 0), waist_c = Vec3(0, 0.61 * H, 0), chest_c = Vec3(0, 0.72 * H, 0);
+    lm.shoulder_y = 0.82 * H;
+  }
+  try {
+    lm.hips = measure_section(rest, hip_c.y(), hip_c.x(), hip_c.z());
+    lm.waist = measure_section(rest, waist_c.y(), waist_c.x(), waist_c.z());
+    lm.chest = measure_section(rest, chest_c.y(), chest_c.x(), chest_c.z());
+  } catch (const std::exception&) {
+    // Not a human-like shape (e.g. a test rig): leave the sections empty.
+  }
+  // Crotch: lowest crossing of the vertical line through the hip centre.
+  lm.crotch_y = 0;
+  const double x = hip_c.x(), z = hip_c.z();
+  double best = 1e300;
+  for (Eigen::Index f = 0; f < rest.F.rows(); ++f) {
+    const Vec3 a = rest.V.row(rest.F(f, 0)), b = rest.V.row(rest.F(f, 1)), c = rest.V.row(rest.F(f, 2));
+    // 2-D barycentrics in the xz plane
+    const double d = (b.x() - a.x()) * (c.z() - a.z()) - (c.x() - a.x()) * (b.z() - a.z());
+    if (std::abs(d) < 1e-18) continue;
+    const double u = ((x - a.x()) * (c.z() - a.z()) - (c.x() - a.x()) * (z - a.z())) / d;
+    const double v = ((b.x() - a.x()) * (z - a.z()) - (x - a.x()) * (b.z() - a.z())) / d;
+    if (u < 0 || v < 0 || u + v > 1) continue;
+    best = std::min(best, a.y() + u * (b.y() - a.y()) + v * (c.y() - a.y()));
+  }
+  if (best < 1e300) lm.crotch_y = best;
+  return lm;
+}
+
+BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_only) {
+  if (!(opt.fps > 0) || !(opt.height > 0) || opt.rest_blend_frames < 0 || !(opt.start_seconds >= 0) ||
+      !(opt.body_edge > 0))
+    gdsr::fail("load_body_sequence: " + path,
+               "bad BodyOptions (fps, height, body_edge must be > 0, rest_blend_frames and start_seconds >= 0)");
+  if (!std::ifstream(path).good()) gdsr::fail("load_body_sequence: " + path, "file not found or not readable");
+  Assimp::Importer imp;
+  const aiScene* s =
+      imp.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_LimitBoneWeights);
+  if (!s || !s->mRootNode)
+    gdsr::fail("load_body_sequence: " + path, std::string("assimp cannot read it: ") + imp.GetErrorString());
+
+  const Clip clip = read_clip(s, path, opt);
+  if (opt.start_seconds > clip.duration)
+    gdsr::fail("load_body_sequence: " + path,
+               "start_seconds beyond the clip length " + std::to_string(clip.duration) + " s");
+  double end = clip.duration;
+  if (opt.max_seconds >= 0) end = std::min(end, opt.start_seconds + opt.max_seconds);
+  const int n_motion = rest_only ? 1 : static_cast<int>(std::floor((end - opt.start_seconds) * opt.fps + 1e-9)) + 1;
+
+  // Rest pose: the file's rest rotations with the first motion frame's translations.
+  const std::vector<Trs> first = pose_at(clip, opt.start_seconds);
+  std::vector<Trs> rest_local(clip.rig.rest);
+  for (size_t i = 0; i < clip.rig.node.size(); ++i)
+    if (clip.rig.channel[i]) rest_local[i].t = first[i].t;
+  const std::vector<Mat4> G_rest = clip.rig.globals(rest_local);
+
+  const Surface surf = build_surface(s, clip, G_rest, path, opt);
+  const Points3 rest_raw = surf.sk.apply(G_rest);
+  const ToMetres to_out = to_metres(rest_raw, opt.height, clip.skinned ? 0.0 : surf.sb.leg_extra, path);
+
+  BodySequence seq;
+  seq.F = surf.sk.F;
+  orient_outward(seq.F, rest_raw);
+  seq.fps = opt.fps;
+  seq.source = path;
+  seq.from_skeleton = !clip.skinned;
+  seq.rest_V = to_out(rest_raw);
+  seq.rest_blend_frames = rest_only ? 0 : opt.rest_blend_frames;
+  if (!rest_only)
+    seq.frames = animate(clip, surf.sk, to_out, rest_local, first, opt.rest_blend_frames, n_motion, opt, path);
+  seq.landmarks = measure_landmarks(TriMesh{seq.rest_V, seq.F}, surf, to_out, clip.skinned, opt.height);
+  return seq;
+}
+
+}  // namespace
+
+TriMesh BodySequence::frame_mesh(int t) const {
+  if (t < 0 || t >= num_frames())
+    gdsr::fail("BodySequence::frame_mesh",
+               "frame " + std::to_string(t) + " out of range [0, " + std::to_string(num_frames()) + ") for " + source);
+  return TriMesh{frames[t], F};
+}
+
+BodySequence load_body_sequence(const std::string& path, const BodyOptions& opt) { return load(path, opt, false); }
+
+BodySection measure_section(const TriMesh& mesh, double y, double ax, double az, double max_radius) {
+  std::vector<Vec2> pts;
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+    for (int e = 0; e < 3; ++e) {
+      const Vec3 a = mesh.V.row(mesh.F(f, e)), b = mesh.V.row(mesh.F(f, (e + 1) % 3));
+      if ((a.y() - y) * (b.y() - y) > 0 || a.y() == b.y()) continue;
+      const double s = (y - a.y()) / (b.y() - a.y());
+      const Vec3 p = a + s * (b - a);
+      if (std::hypot(p.x() - ax, p.z() - az) <= max_radius) pts.emplace_back(p.x(), p.z());
+    }
+  if (pts.size() < 3)
+    gdsr::fail("measure_section", "plane y = " + std::to_string(y) + " misses the mesh near the axis");
+  // Convex hull (monotone chain) for the circumference.
+  std::sort(pts.begin(), pts.end(),
+            [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  auto cross = [](const Vec2& o, const Vec2& a, const Vec2& b) {
+    return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
+  };
+  std::vector<Vec2> hull(2 * pts.size());
+  size_t k = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
+    hull[k++] = pts[i];
+  }
+  for (size_t i = pts.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && cross(hull[k - 2], hull[k - 1], pts[i - 1]) <= 0) --k;
+    hull[k++] = pts[i - 1];
+  }
+  hull.resize(k - 1);
+  BodySection s;
+  s.y = y;
+  double x0 = 1e300, x1 = -1e300, z0 = 1e300, z1 = -1e300;
+  for (const Vec2& p : pts)
+    x0 = std::min(x0, p.x()), x1 = std::max(x1, p.x()), z0 = std::min(z0, p.y()), z1 = std::max(z1, p.y());
+  s.cx = 0.5 * (x0 + x1), s.cz = 0.5 * (z0 + z1);
+  s.half_width = 0.5 * (x1 - x0), s.half_depth = 0.5 * (z1 - z0);
+  for (size_t i = 0; i < hull.size(); ++i) s.circumference += (hull[(i + 1) % hull.size()] - hull[i]).norm();
+  return s;
+}
+
+TriMesh load_body_rest(const std::string& path, const BodyOptions& opt, BodyLandmarks* landmarks) {
+  BodySequence s = load(path, opt, true);
+  if (landmarks) *landmarks = s.landmarks;
+  return s.rest_mesh();
+}
+
+}  // namespace gdsr

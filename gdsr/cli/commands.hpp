@@ -1,0 +1,13 @@
+// Subcommands of the gdsr executable. Each command file defines one add_xxx_command that
+// registers its subcommand (and its callback) on the top-level app; main.cpp calls them.
+#pragma once
+
+namespace CLI {
+class App;
+}
+
+void add_data_command(CLI::App& app);   // train/cmd_data.cpp: gdsr data make|preview|import-md|check
+void add_train_command(CLI::App& app);  // train/cmd_train.cpp: gdsr train
+void add_infer_command(CLI::App& app);  // infer/cmd_infer.cpp: gdsr infer
+void add_eval_command(CLI::App& app);   // infer/cmd_eval.cpp: gdsr eval
+void add_demo_command(CLI::App& app);   // train/cmd_demo.cpp: gdsr demo (the README's main job)

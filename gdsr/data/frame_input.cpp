@@ -1,0 +1,41 @@
+#include "gdsr/data/frame_input.hpp"
+
+#include "gdsr/error.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace gdsr {
+
+FrameInput make_frame_input(const Dataset& d, int t, const Points3& chat_tm1, const Points3& chat_tm2,
+                            BodyQuery* body) {
+  const int T = static_cast<int>(d.lr_frames.size());
+  if (t < 0 || t >= T)
+    gdsr::fail("frame_input",
+               "frame " + std::to_string(t) + " is outside the sequence of " + std::to_string(T) + " frames");
+  FrameInput in;
+  in.C_t = d.lr_frames[t];
+  in.C_tm1 = d.lr_frames[std::max(t - 1, 0)];
+  in.C_tm2 = d.lr_frames[std::max(t - 2, 0)];
+  in.Chat_tm1 = chat_tm1;
+  in.Chat_tm2 = chat_tm2;
+  in.has_body = body != nullptr && d.has_body();
+  if (in.has_body) {
+    body->update(d.body_frames[t]);
+    const ClosestPoints now = body->closest(in.C_t);
+    const ClosestPoints before = body->closest(in.C_tm1);
+    in.contact_t = {now.point, now.normal};
+    in.contact_tm1 = {before.point, before.normal};
+  }
+  return in;
+}
+
+std::unique_ptr<BodyQuery> make_body_query(const Dataset& d) {
+  if (!d.has_body()) return nullptr;
+  TriMesh m;
+  m.V = d.body_frames.front();
+  m.F = d.body_faces;
+  return std::make_unique<BodyQuery>(m, BodyQuery::Update::Refit);
+}
+
+}  // namespace gdsr

@@ -1,0 +1,293 @@
+#include "gdsr/data/validity.hpp"
+
+#include "gdsr/error.hpp"
+
+#include "gdsr/body/body_query.hpp"
+#include "gdsr/geometry/correspondence.hpp"
+#include "gdsr/geometry/self_intersections.hpp"
+#include "gdsr/geometry/wrinkles.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace gdsr {
+namespace {
+
+// HR / LR, NaN when LR's figure is below 1e-12 (nothing to compare with; rounding noise).
+double ratio(double hr, double lr) { return lr > 1e-12 ? hr / lr : std::numeric_limits<double>::quiet_NaN(); }
+
+double median(std::vector<long> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? static_cast<double>(v[n / 2]) : 0.5 * static_cast<double>(v[n / 2 - 1] + v[n / 2]);
+}
+
+// Self-intersection figures of one resolution over the checked frames (frames in parallel:
+// each CGAL call is independent).
+void measure_intersections(const std::vector<Points3>& frames, const Faces& F, int stride, ResolutionValidity& r) {
+  const int T = static_cast<int>(frames.size());
+  std::vector<int> checked;
+  for (int t = 0; t < T; t += stride) checked.push_back(t);
+  std::vector<SelfIntersections> si(checked.size());
+  std::string error;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int k = 0; k < static_cast<int>(checked.size()); ++k) {
+    try {
+      si[k] = self_intersections(frames[checked[k]], F);
+    } catch (const std::exception& e) {
+#pragma omp critical(validity_error)
+      error = e.what();
+    }
+  }
+  if (!error.empty()) throw Error(error);
+  std::vector<long> pairs;
+  r.si_frames = static_cast<int>(checked.size());
+  for (size_t k = 0; k < checked.size(); ++k) {
+    pairs.push_back(si[k].pairs);
+    r.si_clean_frames += si[k].pairs == 0;
+    if (si[k].pairs > r.si_max_pairs || r.si_max_frame < 0) {
+      r.si_max_pairs = si[k].pairs;
+      r.si_max_frame = checked[k];
+    }
+    r.si_degenerate_faces = std::max(r.si_degenerate_faces, si[k].degenerate_faces);
+    r.si_skipped_faces = std::max(r.si_skipped_faces, si[k].skipped_faces);
+  }
+  r.si_median_pairs = median(pairs);
+}
+
+// Deepest garment vertex under the body surface (metres, 0 if none).
+double penetration(const BodyQuery& body, const Points3& X) {
+  const ClosestPoints cp = body.closest(X, /*smooth_normals=*/false);
+  double depth = 0;
+  for (long i = 0; i < X.rows(); ++i)
+    if (cp.face(i) >= 0 && cp.sdist(i) < 0) depth = std::max(depth, -cp.sdist(i));
+  return depth;
+}
+
+void add_penetration(double depth, int t, double limit, ResolutionValidity& r) {
+  if (depth > r.max_penetration) {  // the frame stays -1 while nothing penetrates
+    r.max_penetration = depth;
+    r.max_penetration_frame = t;
+  }
+  r.frames_over_limit += depth > limit;
+}
+
+double mean_distance(const Points3& a, const Points3& b) {
+  return a.rows() > 0 ? (a - b).rowwise().norm().mean() : 0.0;
+}
+
+}  // namespace
+
+double ValidityFigures::strain_ratio_u() const { return ratio(hr.strain.E_u, lr.strain.E_u); }
+double ValidityFigures::strain_ratio_v() const { return ratio(hr.strain.E_v, lr.strain.E_v); }
+double ValidityFigures::strain_ratio_uv() const { return ratio(hr.strain.E_uv, lr.strain.E_uv); }
+
+ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, const ProgressFn& progress) {
+  if (opt.intersection_stride < 1) fail("validity", "intersection stride must be >= 1");
+  if (!(opt.penetration_limit >= 0)) fail("validity", "penetration limit must be >= 0");
+  const int T = static_cast<int>(d.lr_frames.size());
+  if (T == 0 || d.hr_frames.size() != d.lr_frames.size())
+    fail("validity", "the dataset has no frames (or LR/HR counts differ)");
+  ValidityFigures v;
+  v.frames = T;
+  v.intersection_stride = opt.intersection_stride;
+  v.penetration_limit = opt.penetration_limit;
+  v.lr.faces = static_cast<int>(d.lr.F.rows());
+  v.hr.faces = static_cast<int>(d.hr.F.rows());
+  v.body_measured = opt.body && d.has_body();
+  v.agreement_rest = mean_distance(d.hr.V, upsample(d.corr, d.lr.V));
+
+  const int steps = T + 2;  // the per-frame figures, then the LR and the HR self-intersections
+  std::unique_ptr<BodyQuery> body;
+  for (int t = 0; t < T; ++t) {
+    auto strain = [&](const GarmentMesh& g, const Points3& X, ResolutionValidity& r) {
+      const StrainEnergies e = strain_energies(g, X);
+      r.strain.E_u += e.E_u / T;
+      r.strain.E_v += e.E_v / T;
+      r.strain.E_uv += e.E_uv / T;
+      r.mean_curvature += wrinkle_measure(X, g.F).mean_curvature / T;
+    };
+    strain(d.lr, d.lr_frames[t], v.lr);
+    strain(d.hr, d.hr_frames[t], v.hr);
+    const Points3 up = upsample(d.corr, d.lr_frames[t]);
+    v.upsampled_mean_curvature += wrinkle_measure(up, d.hr.F).mean_curvature / T;
+    const double agree = mean_distance(d.hr_frames[t], up);
+    v.agreement_mean += agree / T;
+    if (agree > v.agreement_max || v.agreement_max_frame < 0) {
+      v.agreement_max = agree;
+      v.agreement_max_frame = t;
+    }
+    if (v.body_measured) {
+      const TriMesh mesh{d.body_frames[t], d.body_faces};
+      if (!body)
+        body = std::make_unique<BodyQuery>(mesh);
+      else
+        body->update(d.body_frames[t]);
+      add_penetration(penetration(*body, d.lr_frames[t]), t, opt.penetration_limit, v.lr);
+      add_penetration(penetration(*body, d.hr_frames[t]), t, opt.penetration_limit, v.hr);
+    }
+    if (progress) progress(t + 1, steps);
+  }
+  measure_intersections(d.lr_frames, d.lr.F, opt.intersection_stride, v.lr);
+  if (progress) progress(T + 1, steps);
+  measure_intersections(d.hr_frames, d.hr.F, opt.intersection_stride, v.hr);
+  if (progress) progress(steps, steps);
+  return v;
+}
+
+// ---------------------------------------------------------------- manifest JSON
+
+namespace {
+
+nlohmann::json resolution_json(const ResolutionValidity& r, bool body) {
+  nlohmann::json j = {{"faces", r.faces},
+                      {"self_intersection",
+                       {{"frames_checked", r.si_frames},
+                        {"clean_frames", r.si_clean_frames},
+                        {"clean_fraction", r.si_clean_fraction()},
+                        {"median_pairs", r.si_median_pairs},
+                        {"max_pairs", r.si_max_pairs},
+                        {"max_pairs_frame", r.si_max_frame},
+                        {"degenerate_faces", r.si_degenerate_faces},
+                        {"skipped_faces", r.si_skipped_faces}}},
+                      {"strain", {{"E_u", r.strain.E_u}, {"E_v", r.strain.E_v}, {"E_uv", r.strain.E_uv}}},
+                      {"mean_curvature_1_m", r.mean_curvature}};
+  if (body)
+    j["body"] = {{"max_penetration_m", r.max_penetration},
+                 {"max_penetration_frame", r.max_penetration_frame},
+                 {"frames_over_limit", r.frames_over_limit}};
+  return j;
+}
+
+template <class T> T take(const nlohmann::json& j, const char* key, const std::string& where) {
+  if (!j.is_object() || !j.contains(key)) fail("validity", "manifest figures: missing key '" + where + key + "'");
+  try {
+    return j.at(key).get<T>();
+  } catch (const std::exception&) {
+    fail("validity", "manifest figures: key '" + where + key + "' has the wrong type");
+  }
+}
+
+ResolutionValidity resolution_from_json(const nlohmann::json& j, bool body, const std::string& where) {
+  ResolutionValidity r;
+  r.faces = take<int>(j, "faces", where);
+  const auto si = take<nlohmann::json>(j, "self_intersection", where);
+  const std::string w = where + "self_intersection.";
+  r.si_frames = take<int>(si, "frames_checked", w);
+  r.si_clean_frames = take<int>(si, "clean_frames", w);
+  r.si_median_pairs = take<double>(si, "median_pairs", w);
+  r.si_max_pairs = take<long>(si, "max_pairs", w);
+  r.si_max_frame = take<int>(si, "max_pairs_frame", w);
+  r.si_degenerate_faces = take<long>(si, "degenerate_faces", w);
+  r.si_skipped_faces = take<long>(si, "skipped_faces", w);
+  const auto st = take<nlohmann::json>(j, "strain", where);
+  r.strain.E_u = take<double>(st, "E_u", where + "strain.");
+  r.strain.E_v = take<double>(st, "E_v", where + "strain.");
+  r.strain.E_uv = take<double>(st, "E_uv", where + "strain.");
+  r.mean_curvature = take<double>(j, "mean_curvature_1_m", where);
+  if (body) {
+    const auto b = take<nlohmann::json>(j, "body", where);
+    r.max_penetration = take<double>(b, "max_penetration_m", where + "body.");
+    r.max_penetration_frame = take<int>(b, "max_penetration_frame", where + "body.");
+    r.frames_over_limit = take<int>(b, "frames_over_limit", where + "body.");
+  }
+  return r;
+}
+
+}  // namespace
+
+nlohmann::json validity_to_json(const ValidityFigures& v) {
+  return {{"frames", v.frames},
+          {"intersection_stride", v.intersection_stride},
+          {"penetration_limit_m", v.penetration_limit},
+          {"body_measured", v.body_measured},
+          {"lr", resolution_json(v.lr, v.body_measured)},
+          {"hr", resolution_json(v.hr, v.body_measured)},
+          {"agreement_m",
+           {{"mean", v.agreement_mean},
+            {"max_frame_mean", v.agreement_max},
+            {"max_frame", v.agreement_max_frame},
+            {"rest", v.agreement_rest}}},
+          {"lr_upsampled_mean_curvature_1_m", v.upsampled_mean_curvature}};
+}
+
+ValidityFigures validity_from_json(const nlohmann::json& j) {
+  ValidityFigures v;
+  v.frames = take<int>(j, "frames", "");
+  v.intersection_stride = take<int>(j, "intersection_stride", "");
+  v.penetration_limit = take<double>(j, "penetration_limit_m", "");
+  v.body_measured = take<bool>(j, "body_measured", "");
+  v.lr = resolution_from_json(take<nlohmann::json>(j, "lr", ""), v.body_measured, "lr.");
+  v.hr = resolution_from_json(take<nlohmann::json>(j, "hr", ""), v.body_measured, "hr.");
+  const auto a = take<nlohmann::json>(j, "agreement_m", "");
+  v.agreement_mean = take<double>(a, "mean", "agreement_m.");
+  v.agreement_max = take<double>(a, "max_frame_mean", "agreement_m.");
+  v.agreement_max_frame = take<int>(a, "max_frame", "agreement_m.");
+  v.agreement_rest = take<double>(a, "rest", "agreement_m.");
+  v.upsampled_mean_curvature = take<double>(j, "lr_upsampled_mean_curvature_1_m", "");
+  return v;
+}
+
+// ---------------------------------------------------------------- table
+
+std::string validity_table(const ValidityFigures& v) {
+  std::string s;
+  char buf[256];
+  auto line = [&](const char* fmt, auto... args) {
+    std::snprintf(buf, sizeof buf, fmt, args...);
+    s += buf;
+  };
+  auto ratio_str = [](double r) {
+    char b[32];
+    if (std::isnan(r)) return std::string("-");
+    std::snprintf(b, sizeof b, "%.2fx", r);
+    return std::string(b);
+  };
+  const std::string every =
+      v.intersection_stride == 1 ? "every frame" : "1 frame in " + std::to_string(v.intersection_stride);
+  line("validity over %d frames (self-intersections on %s: %d checked)\n", v.frames, every.c_str(), v.hr.si_frames);
+  line("  %-40s %14s %14s %9s\n", "", "LR", "HR", "HR/LR");
+  line("  %-40s %14d %14d\n", "faces", v.lr.faces, v.hr.faces);
+  line("  %-40s %13.1f%% %13.1f%%\n", "self-intersection: frames with 0 pairs", 100 * v.lr.si_clean_fraction(),
+       100 * v.hr.si_clean_fraction());
+  line("  %-40s %14.1f %14.1f\n", "self-intersection: median pairs", v.lr.si_median_pairs, v.hr.si_median_pairs);
+  line("  %-40s %8ld (f%3d) %8ld (f%3d)\n", "self-intersection: max pairs (frame)", v.lr.si_max_pairs,
+       v.lr.si_max_frame, v.hr.si_max_pairs, v.hr.si_max_frame);
+  if (v.lr.si_degenerate_faces + v.hr.si_degenerate_faces + v.lr.si_skipped_faces + v.hr.si_skipped_faces > 0)
+    line("  %-40s %6ld / %5ld %6ld / %5ld\n", "  degenerate / non-manifold faces skipped", v.lr.si_degenerate_faces,
+         v.lr.si_skipped_faces, v.hr.si_degenerate_faces, v.hr.si_skipped_faces);
+  line("  %-40s %14.5f %14.5f %9s\n", "strain: mean E_u", v.lr.strain.E_u, v.hr.strain.E_u,
+       ratio_str(v.strain_ratio_u()).c_str());
+  line("  %-40s %14.5f %14.5f %9s\n", "strain: mean E_v", v.lr.strain.E_v, v.hr.strain.E_v,
+       ratio_str(v.strain_ratio_v()).c_str());
+  line("  %-40s %14.5f %14.5f %9s\n", "strain: mean E_uv", v.lr.strain.E_uv, v.hr.strain.E_uv,
+       ratio_str(v.strain_ratio_uv()).c_str());
+  if (v.body_measured) {
+    auto depth = [](const ResolutionValidity& r) {
+      char b[48];
+      if (r.max_penetration_frame < 0) return std::string("none");
+      std::snprintf(b, sizeof b, "%.1f (f%3d)", 1e3 * r.max_penetration, r.max_penetration_frame);
+      return std::string(b);
+    };
+    line("  %-40s %14s %14s\n", "body: max penetration, mm (frame)", depth(v.lr).c_str(), depth(v.hr).c_str());
+    line("  body: frames deeper than %-15s %14d %14d\n",
+         (std::to_string(static_cast<int>(std::lround(1e3 * v.penetration_limit))) + " mm").c_str(),
+         v.lr.frames_over_limit, v.hr.frames_over_limit);
+  } else {
+    line("  %-40s %14s %14s\n", "body: penetration", "not measured", "(no body)");
+  }
+  line("  %-40s %14.3f %14.3f\n", "wrinkles: mean |mean curvature|, 1/m", v.lr.mean_curvature, v.hr.mean_curvature);
+  line("  %-40s %14.3f %14s %9s\n", "  LR upsampled to HR topology", v.upsampled_mean_curvature, "",
+       ratio_str(ratio(v.hr.mean_curvature, v.upsampled_mean_curvature)).c_str());
+  line("  agreement |HR - LR upsampled|, mm: mean %.1f over the clip, worst frame %.1f (f%d), rest %.2f\n",
+       1e3 * v.agreement_mean, 1e3 * v.agreement_max, v.agreement_max_frame, 1e3 * v.agreement_rest);
+  return s;
+}
+
+}  // namespace gdsr

@@ -1,0 +1,85 @@
+// Validity figures of a paired LR/HR dataset (issue 10), each measured with a yardstick that is
+// independent of the simulator that made the data, so they apply to any dataset (ours or a
+// Marvelous Designer import):
+//   - self-intersection: intersecting pairs of triangles per frame, CGAL
+//     (gdsr/geometry/self_intersections.hpp; pairs meeting only at a shared vertex/edge do not
+//     count), on every `intersection_stride`-th frame;
+//   - strain: mean E_u, E_v, E_uv against the sewing pattern (gdsr/geometry/strain.hpp);
+//   - body: penetration depth = -signed distance to the body frame (Embree, exact closest
+//     point, gdsr/body/body_query.hpp), only when the dataset has a body;
+//   - agreement: distance of each HR vertex to the LR frame upsampled to HR topology through
+//     the dataset's correspondence (gdsr/geometry/correspondence.hpp);
+//   - wrinkles: mean absolute mean curvature of HR, LR upsampled and LR
+//     (gdsr/geometry/wrinkles.hpp).
+// Every figure is over all frames of the clip (rest-blend frames included). Units: metres,
+// 1/m; strain energies are dimensionless.
+#pragma once
+
+#include "gdsr/data/dataset.hpp"
+#include "gdsr/geometry/strain.hpp"
+#include "gdsr/io/progress.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace gdsr {
+
+struct ValidityOptions {
+  int intersection_stride = 1;       // self-intersections on frames 0, k, 2k, ... (>= 1)
+  double penetration_limit = 0.005;  // metres: frames with a deeper vertex are counted
+  bool body = true;                  // false: skip the penetration even if the dataset has a body
+};
+
+// Figures of one resolution (LR or HR) over the clip.
+struct ResolutionValidity {
+  int faces = 0;
+  // self-intersection (frames checked: every stride-th)
+  int si_frames = 0;           // frames checked
+  int si_clean_frames = 0;     // checked frames with zero intersecting pairs
+  double si_median_pairs = 0;  // median over the checked frames
+  long si_max_pairs = 0;
+  int si_max_frame = -1;         // frame of si_max_pairs
+  long si_degenerate_faces = 0;  // max over checked frames of degenerate (collinear) faces
+  long si_skipped_faces = 0;     // non-manifold faces left out of the test (same every frame)
+  double si_clean_fraction() const { return si_frames > 0 ? static_cast<double>(si_clean_frames) / si_frames : 0; }
+  // strain, means over frames of the per-frame means over triangles
+  StrainEnergies strain;
+  // body (only when measured)
+  double max_penetration = 0;      // metres, max over frames and vertices of -signed distance (0: none)
+  int max_penetration_frame = -1;  // -1: no vertex penetrates in any frame
+  int frames_over_limit = 0;       // frames whose max penetration exceeds the limit
+  double mean_curvature = 0;       // 1/m, mean over frames
+};
+
+struct ValidityFigures {
+  int frames = 0;
+  int intersection_stride = 1;
+  double penetration_limit = 0.005;  // metres
+  bool body_measured = false;
+  ResolutionValidity lr, hr;
+  // agreement: per frame, the mean over HR vertices of |HR - upsample(LR)|, metres
+  double agreement_mean = 0;  // averaged over the clip
+  double agreement_max = 0;   // the worst frame's mean
+  int agreement_max_frame = -1;
+  double agreement_rest = 0;            // the same on the canonical (rest) meshes
+  double upsampled_mean_curvature = 0;  // 1/m, LR upsampled to HR topology, mean over frames
+  // HR / LR of a strain figure (NaN when LR's is below 1e-12)
+  double strain_ratio_u() const;
+  double strain_ratio_v() const;
+  double strain_ratio_uv() const;
+};
+
+// Computes every figure from the dataset (frames must be loaded). Throws gdsr::Error on a
+// dataset without frames or a stride < 1. progress(done, total) counts frames.
+ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt = {}, const ProgressFn& progress = {});
+
+// The manifest's "validity" object (docs/dataset-format.md) and back; from_json throws
+// gdsr::Error naming the missing key.
+nlohmann::json validity_to_json(const ValidityFigures& v);
+ValidityFigures validity_from_json(const nlohmann::json& j);
+
+// A small text table of the figures (several lines, each ending in '\n'), for the command line.
+std::string validity_table(const ValidityFigures& v);
+
+}  // namespace gdsr

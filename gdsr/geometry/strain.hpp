@@ -1,0 +1,22 @@
+// Stretch and shear of a garment against its flat sewing pattern (paper, appendix B): per
+// triangle, w = [w_u w_v] = Ds Dm^-1 is the deformation gradient from UV (metres) to 3-D
+// (metres), and
+//   E_u = (|w_u| - 1)^2,  E_v = (|w_v| - 1)^2,  E_uv = (w_u . w_v)^2   (dimensionless),
+// averaged over triangles. The one implementation used by the simulator's metrics and by
+// `gdsr eval`, so their figures agree.
+#pragma once
+
+#include "gdsr/geometry/mesh.hpp"
+
+namespace gdsr {
+
+struct StrainEnergies {
+  double E_u = 0, E_v = 0, E_uv = 0;  // means over triangles (dimensionless)
+};
+
+// X: positions of g's welded vertices (V x 3, metres), triangles g.F with UV triangles g.FUV.
+// Triangles whose UV area is degenerate (|det Dm| <= 1e-8 x longest UV edge^2, a scale-free
+// test) carry no deformation gradient and are left out of the means.
+StrainEnergies strain_energies(const GarmentMesh& g, const Points3& X);
+
+}  // namespace gdsr

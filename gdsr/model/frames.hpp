@@ -1,0 +1,26 @@
+// Differentiable geometry used by the GDSR network itself (features, E, A): local triangle
+// frames, local -> world mapping and vertex normals, built from autograd ops on a position
+// tensor X [V x 3] (metres) so gradients reach positions and parameters.
+#pragma once
+
+#include "autograd/tensor.hpp"
+#include "gdsr/geometry/geometry_ad.hpp"  // to_tensor / to_points
+#include "gdsr/geometry/mesh.hpp"
+
+namespace gdsr {
+
+// Local frame of the faces `faces` (indices into F) of X: rows (x, y, z) flattened to
+// [n x 9] with y = normalize(v2 - v1), z = normalize((v2 - v1) x (v0 - v1)),
+// x = normalize(y x z); normalize(a) = a / max(|a|, eps) (reference: eps = 1e-6).
+template <class T>
+ag::Tensor<T> triangle_frames_ad(const ag::Tensor<T>& X, const Faces& F, const ag::Index& faces, T eps);
+
+// World vector of local coordinates r [N x 3] in frames [N x 9] (rows x, y, z):
+// r0 x + r1 y + r2 z -> [N x 3].
+template <class T> ag::Tensor<T> local_to_world(const ag::Tensor<T>& r, const ag::Tensor<T>& frames);
+
+// Area-weighted unit vertex normals [V x 3]: sum over adjacent faces of
+// (v1 - v0) x (v2 - v0), divided by max(|sum|, eps) (eps in metres^2).
+template <class T> ag::Tensor<T> vertex_normals_ad(const ag::Tensor<T>& X, const Faces& F, T eps = T(1e-12));
+
+}  // namespace gdsr

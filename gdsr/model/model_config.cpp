@@ -1,0 +1,144 @@
+#include "gdsr/model/model_config.hpp"
+
+#include "gdsr/model/features.hpp"
+
+#include "gdsr/error.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace gdsr {
+
+using nlohmann::json;
+
+int64_t ModelConfig::field_params() const {
+  int64_t total = 0;
+  for (const FieldLayer& l : field_layers()) total += l.out * l.in + l.out;
+  return total;
+}
+
+std::vector<ModelConfig::FieldLayer> ModelConfig::field_layers() const {
+  std::vector<FieldLayer> layers;
+  int64_t offset = 0;
+  const int64_t W = field_width;
+  for (int l = 0; l <= field_wire_layers; ++l) {
+    FieldLayer f;
+    f.in = l == 0 ? 3 : W;
+    f.out = l == field_wire_layers ? 3 : W;
+    f.w_begin = offset;
+    f.b_begin = offset + f.in * f.out;
+    offset = f.b_begin + f.out;
+    layers.push_back(f);
+  }
+  return layers;
+}
+
+namespace {
+void check_widths(const char* name, const std::vector<int64_t>& w) {
+  if (w.size() < 2) gdsr::fail("model_config", std::string(name) + " needs at least two widths");
+  for (int64_t v : w)
+    if (v <= 0) gdsr::fail("model_config", std::string(name) + " has a non-positive width");
+}
+}  // namespace
+
+void ModelConfig::validate() const {
+  check_widths("node_encoder_pre", node_encoder_pre);
+  check_widths("node_encoder_post", node_encoder_post);
+  check_widths("edge_encoder", edge_encoder);
+  check_widths("decoder", decoder);
+  check_widths("e_widths", e_widths);
+  check_widths("a_widths", a_widths);
+  if (node_encoder_pre.front() != kNodeFeatures)
+    gdsr::fail("model_config", "node_encoder_pre must start at " + std::to_string(kNodeFeatures) + " (node features)");
+  if (node_encoder_post.front() != node_encoder_pre.back())
+    gdsr::fail("model_config", "node_encoder_post must start where node_encoder_pre ends");
+  if (edge_encoder.front() != kEdgeFeatures)
+    gdsr::fail("model_config", "edge_encoder must start at " + std::to_string(kEdgeFeatures) + " (edge features)");
+  if (edge_encoder.back() != latent()) gdsr::fail("model_config", "edge_encoder must end at the latent size");
+  if (decoder.front() != latent()) gdsr::fail("model_config", "decoder must start at the latent size");
+  if (z_detail <= 0 || z_detail >= decoder.back())
+    gdsr::fail("model_config", "z_detail must be in (0, decoder.back())");
+  if (e_widths.front() != 3 * z_disp()) gdsr::fail("model_config", "e_widths must start at 3 * z_disp");
+  if (a_widths.front() != 3 * z_detail) gdsr::fail("model_config", "a_widths must start at 3 * z_detail");
+  if (mp_steps < 0) gdsr::fail("model_config", "mp_steps must be >= 0");
+  if (field_width <= 0) gdsr::fail("model_config", "field_width must be positive");
+  if (field_wire_layers < 1) gdsr::fail("model_config", "field_wire_layers must be >= 1");
+  if (!(wire_s0 >= 0) || !(wire_omega0 >= 0)) gdsr::fail("model_config", "wire_omega0 and wire_s0 must be >= 0");
+  if (!(sigma_b > 0) || !(sigma_l > 0)) gdsr::fail("model_config", "sigma_b and sigma_l must be positive");
+  if (!(noise_std >= 0)) gdsr::fail("model_config", "noise_std must be >= 0");
+  if (!(frame_eps > 0)) gdsr::fail("model_config", "frame_eps must be positive");
+  if (!(a_proj_init_gain > 0)) gdsr::fail("model_config", "a_proj_init_gain must be positive");
+}
+
+#define GDSR_CONFIG_FIELDS(X)                                                                                       \
+  X(node_encoder_pre)                                                                                               \
+  X(node_encoder_post) X(edge_encoder) X(mp_steps) X(layer_edge_mlps) X(h_norm) X(decoder) X(z_detail) X(e_widths)  \
+      X(e_scale_init) X(a_widths) X(a_proj_init_gain) X(field_width) X(field_wire_layers) X(wire_omega0) X(wire_s0) \
+          X(field_scale_init) X(sigma_b) X(sigma_l) X(noise_std) X(frame_eps) X(seed)
+
+ModelConfig model_config_from_json_text(const std::string& text, const std::string& origin) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const std::exception& e) {
+    gdsr::fail("model_config", std::string(origin) + " is not valid JSON: " + e.what());
+  }
+  if (!j.is_object()) gdsr::fail("model_config", std::string(origin) + " is not a JSON object");
+  ModelConfig c;
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string& key = it.key();
+    bool known = false;
+    try {
+#define X(name)                                  \
+  if (key == #name) {                            \
+    known = true;                                \
+    c.name = it.value().get<decltype(c.name)>(); \
+  }
+      GDSR_CONFIG_FIELDS(X)
+#undef X
+    } catch (const std::exception& e) {
+      gdsr::fail("model_config", std::string(origin) + ": bad value for '" + key + "': " + e.what());
+    }
+    if (!known && key.rfind("_", 0) != 0)  // keys starting with '_' are comments
+      gdsr::fail("model_config", std::string(origin) + ": unknown key '" + key + "'");
+  }
+  try {
+    c.validate();
+  } catch (const std::exception& e) {
+    throw gdsr::Error(std::string(e.what()) + " (" + origin + ")");  // re-raise with the file named
+  }
+  return c;
+}
+
+ModelConfig load_model_config(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) gdsr::fail("model_config", "cannot open " + path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return model_config_from_json_text(ss.str(), path);
+}
+
+std::string model_config_to_json_text(const ModelConfig& c) {
+  json j;
+#define X(name) j[#name] = c.name;
+  GDSR_CONFIG_FIELDS(X)
+#undef X
+  return j.dump(2) + "\n";
+}
+
+void save_model_config(const ModelConfig& c, const std::string& path) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) gdsr::fail("model_config", "cannot write " + tmp);
+    out << model_config_to_json_text(c);
+    if (!out) gdsr::fail("model_config", "write failed for " + tmp);
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) gdsr::fail("model_config", "cannot rename " + tmp + " to " + path);
+}
+
+}  // namespace gdsr

@@ -1,0 +1,250 @@
+#include "gdsr/sim/body_landmarks.hpp"
+
+#include "gdsr/error.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace sim {
+
+using gdsr::Vec3;
+
+namespace {
+
+// Max horizontal distance from the trunk axis of the body vertices within `slab` of height
+// y0, ignoring vertices further than max_r (arms, hands). -1 if the slab is empty.
+double radial_extent(const gdsr::TriMesh& b, const Vec3& axis, double y0, double slab, double max_r) {
+  double r = -1;
+  for (int v = 0; v < b.V.rows(); ++v) {
+    if (std::abs(b.V(v, 1) - y0) > slab) continue;
+    const double d = std::hypot(b.V(v, 0) - axis.x(), b.V(v, 2) - axis.z());
+    if (d < max_r) r = std::max(r, d);
+  }
+  return r;
+}
+
+// Centre (bounding-box middle in x and z) of the vertices on side `side` (+1: x > axis.x)
+// within `slab` of height y and closer than max_dx to the axis in x; false if none.
+bool leg_centre(const gdsr::TriMesh& b, const Vec3& axis, int side, double y, double slab, Vec3& c,
+                double max_dx = 1e300) {
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (int v = 0; v < b.V.rows(); ++v) {
+    const double dx = side * (b.V(v, 0) - axis.x());
+    if (std::abs(b.V(v, 1) - y) > slab || dx <= 0 || dx > max_dx) continue;
+    lo = lo.cwiseMin(Vec3(b.V.row(v)));
+    hi = hi.cwiseMax(Vec3(b.V.row(v)));
+  }
+  if (lo.x() > hi.x()) return false;
+  c = 0.5 * (lo + hi);
+  c.y() = y;
+  return true;
+}
+
+// Legs: centre lines and the ankle height (the lowest height above the foot where the leg's
+// front-back extent is back to shin size).
+void measure_legs(const gdsr::TriMesh& b, BodyLandmarks& lm) {
+  const double H = lm.height, s = H / 1.75, slab = 0.01 * s;
+  double ankle = lm.floor + 0.05 * H;
+  int found = 0;
+  for (int k = 0; k < 2; ++k) {
+    const int side = k == 0 ? 1 : -1;
+    Vec3 shin;
+    if (!leg_centre(b, lm.axis, side, lm.floor + 0.25 * H, slab, shin)) continue;
+    auto zext = [&](double y) {
+      double lo = 1e300, hi = -1e300;
+      for (int v = 0; v < b.V.rows(); ++v)
+        if (std::abs(b.V(v, 1) - y) <= slab && side * (b.V(v, 0) - lm.axis.x()) > 0 &&
+            std::abs(b.V(v, 0) - shin.x()) < 0.12 * s) {
+          lo = std::min(lo, b.V(v, 2));
+          hi = std::max(hi, b.V(v, 2));
+        }
+      return hi - lo;
+    };
+    const double e_shin = zext(lm.floor + 0.20 * H);
+    double a = lm.floor + 0.12 * H;
+    for (double y = lm.floor + 0.02 * H; y < lm.floor + 0.12 * H; y += 0.004 * s)
+      if (zext(y) < 1.3 * e_shin) {
+        a = y;
+        break;
+      }
+    ankle = found == 0 ? a : std::max(ankle, a);
+    ++found;
+  }
+  lm.ankle_y = ankle;
+  for (int k = 0; k < 2; ++k) {
+    const int side = k == 0 ? 1 : -1;
+    const double ytop = lm.crotch_y - 0.06 * s, ybot = lm.ankle_y + 0.04 * s;
+    if (!leg_centre(b, lm.axis, side, ytop, slab, lm.leg_top[k], 0.22 * s))
+      lm.leg_top[k] = Vec3(lm.axis.x() + side * lm.leg_x, ytop, lm.axis.z());
+    if (!leg_centre(b, lm.axis, side, ybot, slab, lm.leg_bottom[k]))
+      lm.leg_bottom[k] = Vec3(lm.leg_top[k].x(), ybot, lm.leg_top[k].z());
+  }
+}
+
+// Arms: the vertices above the armpits and clear of the trunk on each side, their principal
+// line, the shoulder joint on it at the trunk's side and the wrist at the narrowest section
+// of the outer part of the arm.
+void measure_arms(const gdsr::TriMesh& b, BodyLandmarks& lm) {
+  const double s = lm.height / 1.75;
+  for (int k = 0; k < 2; ++k) {
+    const int side = k == 0 ? 1 : -1;
+    std::vector<Vec3> pts;
+    for (int v = 0; v < b.V.rows(); ++v)
+      if (side * (b.V(v, 0) - lm.axis.x()) > 0.25 * s && b.V(v, 1) > lm.armpit_y - 0.15 * s) pts.push_back(b.V.row(v));
+    if (pts.size() < 30) continue;
+    Vec3 m = Vec3::Zero();
+    for (const auto& p : pts) m += p;
+    m /= static_cast<double>(pts.size());
+    Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+    for (const auto& p : pts) C += (p - m) * (p - m).transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C);
+    Vec3 d = es.eigenvectors().col(2);
+    if (side * d.x() < 0) d = -d;
+    if (side * d.x() < 0.5) continue;  // arm hanging down or forward: not a T/A-pose arm
+    // Shoulder joint: the line's point at 0.17 s from the axis (sideways).
+    const double t_root = (lm.axis.x() + side * 0.17 * s - m.x()) / d.x();
+    double t_max = -1e300;
+    for (const auto& p : pts) t_max = std::max(t_max, (p - m).dot(d));
+    const double L = t_max - t_root;
+    if (!(L > 0.3 * s)) continue;
+    // Radius profile in 1 cm bins along the line.
+    const int nb = static_cast<int>(std::ceil(L / (0.01 * s))) + 1;
+    std::vector<double> rad(nb, 0);
+    for (const auto& p : pts) {
+      const double t = (p - m).dot(d);
+      const int i = static_cast<int>((t - t_root) / (0.01 * s));
+      if (i >= 0 && i < nb) rad[i] = std::max(rad[i], ((p - m) - t * d).norm());
+    }
+    int wrist = nb - 1;
+    for (int i = static_cast<int>(0.55 * nb); i < nb - 3; ++i)
+      if (rad[i] > 0 && rad[i] < rad[wrist]) wrist = i;
+    double r = 0;
+    for (int i = static_cast<int>(0.08 * s / (0.01 * s)); i <= wrist; ++i) r = std::max(r, rad[i]);
+    lm.arm_found[k] = true;
+    lm.arm_root[k] = m + t_root * d;
+    lm.arm_dir[k] = d;
+    lm.arm_len[k] = (wrist + 0.5) * 0.01 * s;
+    lm.arm_r[k] = r;
+  }
+}
+
+// Trunk box, shoulder top and neck section (see the header).
+void measure_upper_trunk(const gdsr::TriMesh& b, BodyLandmarks& lm) {
+  const double s = lm.height / 1.75;
+  auto box = [&](double y0, double y1, double rmin, double rmax, Vec3& lo, Vec3& hi) {
+    lo = Vec3::Constant(1e300);
+    hi = Vec3::Constant(-1e300);
+    for (int v = 0; v < b.V.rows(); ++v) {
+      const double y = b.V(v, 1), r = std::hypot(b.V(v, 0) - lm.axis.x(), b.V(v, 2) - lm.axis.z());
+      if (y < y0 || y > y1 || r < rmin || r > rmax) continue;
+      lo = lo.cwiseMin(Vec3(b.V.row(v)));
+      hi = hi.cwiseMax(Vec3(b.V.row(v)));
+    }
+    if (lo.x() > hi.x()) lo = hi = Vec3(lm.axis.x(), y0, lm.axis.z());
+  };
+  box(lm.hip_y, lm.armpit_y, 0, 0.26 * s, lm.trunk_lo, lm.trunk_hi);
+  lm.shoulder_top_y = lm.shoulder_y;
+  for (int v = 0; v < b.V.rows(); ++v) {
+    const double dx = std::abs(b.V(v, 0) - lm.axis.x());
+    if (dx > 0.09 * s && dx < 0.17 * s && b.V(v, 1) < lm.neck_y + 0.08 * s)
+      lm.shoulder_top_y = std::max(lm.shoulder_top_y, b.V(v, 1));
+  }
+  // Neck (and a chin leaning forward) from just above the shoulder top to 6 cm above it.
+  box(lm.shoulder_top_y + 0.005 * s, lm.shoulder_top_y + 0.06 * s, 0, 0.16 * s, lm.neck_lo, lm.neck_hi);
+}
+
+}  // namespace
+
+gdsr::Vec2 trunk_extent(const gdsr::TriMesh& b, const BodyLandmarks& lm, double y0, double y1, double max_r) {
+  gdsr::Vec2 e(0, 0);
+  for (int v = 0; v < b.V.rows(); ++v) {
+    if (b.V(v, 1) < y0 || b.V(v, 1) > y1) continue;
+    const double dx = b.V(v, 0) - lm.axis.x(), dz = b.V(v, 2) - lm.axis.z();
+    if (std::hypot(dx, dz) >= max_r) continue;
+    e.x() = std::max(e.x(), std::abs(dx));
+    e.y() = std::max(e.y(), std::abs(dz));
+  }
+  return e;
+}
+
+BodyLandmarks measure_body(const gdsr::TriMesh& b) {
+  if (b.V.rows() < 4 || !b.V.allFinite()) gdsr::fail("sim/body_landmarks", "body rest mesh is empty or not finite");
+  BodyLandmarks lm;
+  lm.floor = b.V.col(1).minCoeff();
+  lm.height = b.V.col(1).maxCoeff() - lm.floor;
+  if (!(lm.height > 0.3)) gdsr::fail("sim/body_landmarks", "body is shorter than 0.3 m (expected metres, Y up)");
+  const double H = lm.height, s = H / 1.75;
+  lm.armpit_y = lm.floor + 0.73 * H;
+  lm.shoulder_y = lm.floor + 0.81 * H;
+  lm.neck_y = lm.floor + 0.85 * H;
+  // Trunk axis: mean x, z of the vertices around mid-height of the trunk.
+  Vec3 c = Vec3::Zero();
+  int n = 0;
+  for (int v = 0; v < b.V.rows(); ++v)
+    if (std::abs(b.V(v, 1) - (lm.floor + 0.62 * H)) < 0.03 * s) {
+      c += b.V.row(v).transpose();
+      ++n;
+    }
+  if (n == 0) gdsr::fail("sim/body_landmarks", "body has no trunk at 0.62 of its height");
+  lm.axis = c / n;
+  lm.axis.y() = 0;  // the axis is vertical: only its x, z are meaningful
+  const double slab = 0.015 * s, max_r = 0.28 * s;
+  // Crotch: highest height below 0.56 H where no vertex lies near the mid-plane x = axis.
+  lm.crotch_y = lm.floor + 0.47 * H;
+  for (double y = lm.floor + 0.56 * H; y > lm.floor + 0.35 * H; y -= 0.005 * s) {
+    bool mid = false;
+    for (int v = 0; v < b.V.rows() && !mid; ++v)
+      mid = std::abs(b.V(v, 1) - y) < 0.02 * s && std::abs(b.V(v, 0) - lm.axis.x()) < 0.03 * s;
+    if (!mid) {
+      lm.crotch_y = y;
+      break;
+    }
+  }
+  // Waist: narrowest trunk section between crotch + 0.17 H and 0.72 H; hips: widest below.
+  lm.waist_y = lm.floor + 0.61 * H;
+  lm.waist_r = 1e9;
+  for (double y = lm.crotch_y + 0.17 * H; y <= lm.floor + 0.72 * H; y += 0.005 * s) {
+    const double r = radial_extent(b, lm.axis, y, slab, max_r);
+    if (r > 0 && r < lm.waist_r) {
+      lm.waist_r = r;
+      lm.waist_y = y;
+    }
+  }
+  if (!(lm.waist_r < 1e9)) gdsr::fail("sim/body_landmarks", "body has no trunk at waist height");
+  lm.hip_r = lm.waist_r;
+  lm.hip_y = lm.waist_y;
+  for (double y = lm.crotch_y + 0.03 * s; y <= lm.waist_y; y += 0.005 * s) {
+    const double r = radial_extent(b, lm.axis, y, slab, max_r);
+    if (r > lm.hip_r) {
+      lm.hip_r = r;
+      lm.hip_y = y;
+    }
+  }
+  lm.chest_r = std::max(radial_extent(b, lm.axis, lm.floor + 0.70 * H, slab, 0.24 * s), lm.waist_r);
+  lm.shoulder_halfwidth = 0.19 * s;
+  // Legs: vertices right of the axis at thigh height.
+  double sx = 0;
+  int nl = 0;
+  const double thigh_y = lm.floor + 0.40 * H;
+  for (int v = 0; v < b.V.rows(); ++v)
+    if (std::abs(b.V(v, 1) - thigh_y) < slab && b.V(v, 0) > lm.axis.x() && b.V(v, 0) - lm.axis.x() < max_r) {
+      sx += b.V(v, 0) - lm.axis.x();
+      ++nl;
+    }
+  lm.leg_x = nl ? sx / nl : 0.09 * s;
+  lm.thigh_r = 0.08 * s;
+  lm.bust_r = lm.waist_r;
+  for (double y = lm.waist_y; y <= lm.armpit_y; y += 0.005 * s)
+    lm.bust_r = std::max(lm.bust_r, radial_extent(b, lm.axis, y, slab, 0.24 * s));
+  measure_legs(b, lm);
+  measure_arms(b, lm);
+  measure_upper_trunk(b, lm);
+  return lm;
+}
+
+}  // namespace sim

@@ -1,0 +1,48 @@
+// Landmarks of a standing body's rest pose (Y up, metres): heights of waist, hips, crotch,
+// armpits, shoulders, neck and the trunk radii there, the legs' centre lines down to the
+// ankles and the arms' centre lines (T- or A-pose), measured from the mesh so that every
+// garment pattern fits any human-sized body.
+#pragma once
+
+#include "gdsr/geometry/mesh.hpp"
+
+namespace sim {
+
+struct BodyLandmarks {
+  double floor = 0, height = 0;          // lowest y, total height
+  gdsr::Vec3 axis = gdsr::Vec3::Zero();  // x, z of the (vertical) trunk axis; y = 0
+  double waist_y = 0, hip_y = 0, crotch_y = 0, armpit_y = 0, shoulder_y = 0, neck_y = 0;
+  double waist_r = 0, hip_r = 0;  // max horizontal distance of the trunk from the axis
+  double chest_r = 0, shoulder_halfwidth = 0, leg_x = 0, thigh_r = 0;
+  double bust_r = 0;  // max horizontal distance of the trunk from the axis between waist and armpits
+  // Bounding box of the trunk between hips and armpits (points within 0.26 m x H / 1.75 of the axis).
+  gdsr::Vec3 trunk_lo = gdsr::Vec3::Zero(), trunk_hi = gdsr::Vec3::Zero();
+  // Top of the shoulders between neck and shoulder joints, and the bounding box of the neck
+  // (and chin) from 0.5 cm to 6 cm above it.
+  double shoulder_top_y = 0;
+  gdsr::Vec3 neck_lo = gdsr::Vec3::Zero(), neck_hi = gdsr::Vec3::Zero();
+  // Legs, index 0: the +x side, 1: the -x side. ankle_y: height where the foot ends and the
+  // shin begins; leg_top / leg_bottom: centre of the leg's section just below the crotch and
+  // just above the ankle (spread legs tilt the line).
+  double ankle_y = 0;
+  gdsr::Vec3 leg_top[2] = {gdsr::Vec3::Zero(), gdsr::Vec3::Zero()};
+  gdsr::Vec3 leg_bottom[2] = {gdsr::Vec3::Zero(), gdsr::Vec3::Zero()};
+  // Arms (index 0: +x side, 1: -x side), found when the arm stands clear of the trunk (T- or
+  // A-pose): a centre line from the shoulder joint `arm_root` along the unit `arm_dir`
+  // (outwards) to the wrist at arm_root + arm_len * arm_dir; arm_r: the largest distance of
+  // the arm's surface from that line between shoulder and wrist.
+  bool arm_found[2] = {false, false};
+  gdsr::Vec3 arm_root[2] = {gdsr::Vec3::Zero(), gdsr::Vec3::Zero()};
+  gdsr::Vec3 arm_dir[2] = {gdsr::Vec3::UnitX(), -gdsr::Vec3::UnitX()};
+  double arm_len[2] = {0, 0}, arm_r[2] = {0, 0};
+};
+
+// Half extents of the trunk along x (|x - axis.x|) and z (|z - axis.z|) over the body's
+// vertices with y0 <= y <= y1 and horizontal distance from the axis below max_r (metres).
+// Returns (0, 0) when no vertex qualifies.
+gdsr::Vec2 trunk_extent(const gdsr::TriMesh& body_rest, const BodyLandmarks& lm, double y0, double y1, double max_r);
+
+// Throws for an empty or non-finite mesh, a body shorter than 0.3 m, or one without a trunk.
+BodyLandmarks measure_body(const gdsr::TriMesh& body_rest);
+
+}  // namespace sim

@@ -1,0 +1,40 @@
+// Closest points on a moving triangle surface (the body) for the cloth solver and the
+// metrics: a uniform grid over the triangles' bounding boxes, valid for every linear blend
+// between two poses, queried within a search radius. Exact within the radius (every
+// triangle whose box is in reach is tested), deterministic (ties go to the lower face id).
+// Positions in metres.
+#pragma once
+
+#include "gdsr/geometry/mesh.hpp"
+
+#include <unordered_map>
+#include <vector>
+
+namespace sim {
+
+struct SurfaceHit {
+  int face = -1;                           // -1: nothing within the radius
+  gdsr::Vec3 bary = gdsr::Vec3::Zero();    // barycentric of the closest point in `face`
+  gdsr::Vec3 point = gdsr::Vec3::Zero();   // closest surface point
+  gdsr::Vec3 normal = gdsr::Vec3::Zero();  // outward unit normal there (face normals averaged over ties)
+  double signed_distance = 0;              // > 0 outside, < 0 inside (metres)
+};
+
+class SurfaceGrid {
+ public:
+  // Grid for triangles F over poses V0 and V1 (and any blend between them); cell in metres.
+  void build(const gdsr::Faces& F, const gdsr::Points3& V0, const gdsr::Points3& V1, double cell);
+  // Closest point on the surface with vertex positions V (same topology, a pose covered by
+  // build) to x, searching within `radius` metres.
+  SurfaceHit closest(const gdsr::Vec3& x, const gdsr::Points3& V, double radius) const;
+  bool empty() const { return cells_.empty(); }
+
+ private:
+  long long key(int i, int j, int k) const;
+  const gdsr::Faces* F_ = nullptr;
+  double cell_ = 0;
+  gdsr::Vec3 origin_ = gdsr::Vec3::Zero();
+  std::unordered_map<long long, std::vector<int>> cells_;
+};
+
+}  // namespace sim

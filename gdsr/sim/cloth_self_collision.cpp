@@ -1,0 +1,390 @@
+#include "gdsr/sim/cloth_self_collision.hpp"
+
+#include "gdsr/error.hpp"
+#include "gdsr/geometry/triangle.hpp"
+
+#include <embree3/rtcore.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace sim {
+
+using gdsr::Points3;
+using gdsr::Vec3;
+
+namespace {
+
+[[noreturn]] void fail(const std::string& msg) { gdsr::fail("sim/cloth_self_collision", msg); }
+
+// Closest points of segments p1q1 and p2q2 (Ericson, Real-Time Collision Detection 5.1.9):
+// parameters s (on the first) and t (on the second) in [0, 1].
+void closest_segments(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2, double& s, double& t) {
+  const Vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  const double eps = 1e-30;
+  if (a <= eps && e <= eps) {
+    s = t = 0;
+    return;
+  }
+  if (a <= eps) {
+    s = 0;
+    t = std::clamp(f / e, 0.0, 1.0);
+    return;
+  }
+  const double c = d1.dot(r);
+  if (e <= eps) {
+    t = 0;
+    s = std::clamp(-c / a, 0.0, 1.0);
+    return;
+  }
+  const double b = d1.dot(d2), denom = a * e - b * b;
+  s = denom > 0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+  t = (b * s + f) / e;
+  if (t < 0) {
+    t = 0;
+    s = std::clamp(-c / a, 0.0, 1.0);
+  } else if (t > 1) {
+    t = 1;
+    s = std::clamp((b - c) / a, 0.0, 1.0);
+  }
+}
+
+// Does segment pq cross triangle abc (proper crossing; touching does not count)?
+bool segment_crosses_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 n = (b - a).cross(c - a);
+  const double dp = n.dot(p - a), dq = n.dot(q - a);
+  if ((dp > 0) == (dq > 0) || dp == 0 || dq == 0) return false;
+  const Vec3 d = q - p;
+  const double s1 = (a - p).cross(b - p).dot(d);
+  const double s2 = (b - p).cross(c - p).dot(d);
+  const double s3 = (c - p).cross(a - p).dot(d);
+  return (s1 > 0 && s2 > 0 && s3 > 0) || (s1 < 0 && s2 < 0 && s3 < 0);
+}
+
+// Barycentric coordinates of the projection of p onto the plane of abc, and the signed
+// distance along the unit normal n (b - a) x (c - a). False for a degenerate triangle.
+bool project_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Vec3& bary, Vec3& n,
+                         double& dist) {
+  const Vec3 e1 = b - a, e2 = c - a;
+  n = e1.cross(e2);
+  const double n2 = n.squaredNorm();
+  if (!(n2 > 1e-30)) return false;
+  const Vec3 ap = p - a;
+  const double w1 = ap.cross(e2).dot(n) / n2;  // weight of b
+  const double w2 = e1.cross(ap).dot(n) / n2;  // weight of c
+  bary = Vec3(1 - w1 - w2, w1, w2);
+  n /= std::sqrt(n2);
+  dist = ap.dot(n);
+  return true;
+}
+
+constexpr double kInside = -1e-3;  // barycentric tolerance: a vertex on a shared edge is guarded by both faces
+constexpr double kEdgeEnd = 1e-3;  // edge parameter tolerance for an interior edge-edge closest point
+
+}  // namespace
+
+// Embree device, the per-detection inputs of the bounds callbacks and the collected pairs.
+// Three primitive sets, each a user geometry in its own scene: vertices, edges and faces,
+// each bounded by its vertices' paths (x to x + motion) grown by `pad`.
+struct SelfCollision::Embree {
+  RTCDevice device = nullptr;
+  const Points3* x = nullptr;
+  const Points3* motion = nullptr;
+  double pad = 0;
+  const SelfCollision* owner = nullptr;
+  std::mutex mutex;
+  std::vector<std::pair<int, int>> pairs;
+  ~Embree() {
+    if (device) rtcReleaseDevice(device);
+  }
+  // Box of the paths of vertices ids[0..n).
+  void bounds(const int* ids, int n, RTCBounds* o) const {
+    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+    for (int k = 0; k < n; ++k)
+      for (int c = 0; c < 3; ++c) {
+        const double a = (*x)(ids[k], c), b = a + (*motion)(ids[k], c);
+        lo[c] = std::min(lo[c], std::min(a, b) - pad);
+        hi[c] = std::max(hi[c], std::max(a, b) + pad);
+      }
+    o->lower_x = std::nextafter(static_cast<float>(lo[0]), -1e30f);  // float box, rounded outwards
+    o->lower_y = std::nextafter(static_cast<float>(lo[1]), -1e30f);
+    o->lower_z = std::nextafter(static_cast<float>(lo[2]), -1e30f);
+    o->upper_x = std::nextafter(static_cast<float>(hi[0]), 1e30f);
+    o->upper_y = std::nextafter(static_cast<float>(hi[1]), 1e30f);
+    o->upper_z = std::nextafter(static_cast<float>(hi[2]), 1e30f);
+  }
+  RTCScene scene(int count, RTCBoundsFunction fn) {
+    RTCScene sc = rtcNewScene(device);
+    rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_LOW);
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+    rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(count));
+    rtcSetGeometryUserData(geom, this);
+    rtcSetGeometryBoundsFunction(geom, fn, nullptr);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(sc, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(sc);
+    return sc;
+  }
+  // Box overlaps (primID0, primID1) between two scenes of the given kinds (0 vertices,
+  // 1 edges, 2 faces) whose primitives share no vertex, each unordered pair once, in no
+  // particular order.
+  int kind0 = 0, kind1 = 0;
+  bool adjacent(int a, int b) const {
+    int ia[3], ib[3];
+    const int na = ids(kind0, a, ia), nb = ids(kind1, b, ib);
+    for (int i = 0; i < na; ++i)
+      for (int j = 0; j < nb; ++j)
+        if (ia[i] == ib[j]) return true;
+    return false;
+  }
+  int ids(int kind, int p, int* out) const {
+    if (kind == 0) {
+      out[0] = p;
+      return 1;
+    }
+    if (kind == 1) {
+      out[0] = owner->edges_[p][0], out[1] = owner->edges_[p][1];
+      return 2;
+    }
+    for (int k = 0; k < 3; ++k) out[k] = owner->F_(p, k);
+    return 3;
+  }
+  std::vector<std::pair<int, int>> collide(RTCScene a, int ka, RTCScene b, int kb) {
+    pairs.clear();
+    kind0 = ka;
+    kind1 = kb;
+    rtcCollide(
+        a, b,
+        [](void* user, RTCCollision* c, unsigned int n) {
+          auto* e = static_cast<Embree*>(user);
+          const bool self = e->kind0 == e->kind1;
+          std::pair<int, int> keep[256];
+          int nk = 0;
+          for (unsigned k = 0; k < n; ++k) {
+            const int p = static_cast<int>(c[k].primID0), q = static_cast<int>(c[k].primID1);
+            if ((self && p >= q) || e->adjacent(p, q)) continue;
+            if (nk == 256) {
+              std::lock_guard<std::mutex> lock(e->mutex);
+              e->pairs.insert(e->pairs.end(), keep, keep + nk);
+              nk = 0;
+            }
+            keep[nk++] = {p, q};
+          }
+          std::lock_guard<std::mutex> lock(e->mutex);
+          e->pairs.insert(e->pairs.end(), keep, keep + nk);
+        },
+        this);
+    const RTCError err = rtcGetDeviceError(device);
+    if (err != RTC_ERROR_NONE) fail("Embree collide failed (error " + std::to_string(static_cast<int>(err)) + ")");
+    return std::move(pairs);  // in callback order: the caller sorts what it keeps
+  }
+};
+
+SelfCollision::SelfCollision(const gdsr::Faces& F, int num_vertices) : F_(F), embree_(std::make_unique<Embree>()) {
+  if (F.rows() > 0 && (F.minCoeff() < 0 || F.maxCoeff() >= num_vertices)) fail("faces index missing vertices");
+  std::map<std::pair<int, int>, int> ids;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int i = F(f, k), j = F(f, (k + 1) % 3);
+      const auto key = std::make_pair(std::min(i, j), std::max(i, j));
+      if (ids.emplace(key, static_cast<int>(edges_.size())).second) edges_.push_back({key.first, key.second});
+    }
+  tangled_.assign(num_vertices, 0);
+  embree_->device = rtcNewDevice("threads=1");
+  if (!embree_->device) fail("cannot create an Embree device");
+}
+
+SelfCollision::~SelfCollision() = default;
+
+int SelfCollision::num_tangled_vertices() const {
+  return static_cast<int>(std::count(tangled_.begin(), tangled_.end(), 1));
+}
+
+void SelfCollision::detect(const Points3& x, const Points3& motion, double slack, double thickness, bool tangle_test) {
+  const int nf = static_cast<int>(F_.rows()), nv = static_cast<int>(x.rows()), ne = static_cast<int>(edges_.size());
+  if (motion.rows() != x.rows() || static_cast<int>(tangled_.size()) != x.rows())
+    fail("positions or motion do not match the vertex count");
+  if (!(slack >= 0) || !(thickness > 0)) fail("slack must be >= 0 and thickness > 0");
+  vt_.clear();
+  ee_.clear();
+  if (tangle_test) {
+    std::fill(tangled_.begin(), tangled_.end(), 0);
+    intersecting_ = 0;
+  }
+  if (nf < 2) return;
+  ++detections_;
+
+  // Broad phase: vertex, edge and face path boxes (Embree BVHs), collided pairwise.
+  auto& E = *embree_;
+  E.x = &x;
+  E.motion = &motion;
+  E.pad = 0.5 * thickness + slack;
+  E.owner = this;
+  RTCScene sv = E.scene(nv, [](const RTCBoundsFunctionArguments* a) {
+    const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
+    const int v = static_cast<int>(a->primID);
+    e->bounds(&v, 1, a->bounds_o);
+  });
+  RTCScene se = E.scene(ne, [](const RTCBoundsFunctionArguments* a) {
+    const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
+    e->bounds(e->owner->edges_[a->primID].data(), 2, a->bounds_o);
+  });
+  RTCScene sf = E.scene(nf, [](const RTCBoundsFunctionArguments* a) {
+    const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
+    const int f = static_cast<int>(a->primID);
+    const int ids[3] = {e->owner->F_(f, 0), e->owner->F_(f, 1), e->owner->F_(f, 2)};
+    e->bounds(ids, 3, a->bounds_o);
+  });
+  std::vector<std::pair<int, int>> vf, ee, ef;
+  try {
+    vf = E.collide(sv, 0, sf, 2);
+    ee = E.collide(se, 1, se, 1);
+    if (tangle_test) ef = E.collide(se, 1, sf, 2);
+  } catch (...) {
+    rtcReleaseScene(sv);
+    rtcReleaseScene(se);
+    rtcReleaseScene(sf);
+    throw;
+  }
+  rtcReleaseScene(sv);
+  rtcReleaseScene(se);
+  rtcReleaseScene(sf);
+
+  // Narrow phase (parallel; every candidate writes its own slot, so the result does not
+  // depend on the thread count).
+  std::vector<signed char> vt_keep(vf.size(), 0), ee_keep(ee.size(), 0), ef_cross(ef.size(), 0);
+  std::vector<std::array<float, 3>> ee_dir(ee.size());
+  const int nvf = static_cast<int>(vf.size()), nee = static_cast<int>(ee.size()), nef = static_cast<int>(ef.size());
+#pragma omp parallel
+  {
+#pragma omp for schedule(static) nowait
+    for (int k = 0; k < nvf; ++k) {
+      const int v = vf[k].first, g = vf[k].second;
+      const Vec3 p = x.row(v), a = x.row(F_(g, 0)), b = x.row(F_(g, 1)), c = x.row(F_(g, 2));
+      const double d = (p - gdsr::closest_point_on_triangle(p, a, b, c).point).norm();
+      // Relative motion of the vertex against any point of the triangle is bounded by the
+      // largest against its corners; each side may also leave its path by `slack`.
+      double rel = 0;
+      for (int i = 0; i < 3; ++i) rel = std::max(rel, (motion.row(v) - motion.row(F_(g, i))).norm());
+      if (d >= thickness + rel + 2 * slack) continue;
+      Vec3 bary, n;
+      double dist = 0;
+      if (!project_on_triangle(p, a, b, c, bary, n, dist)) continue;
+      vt_keep[k] = dist >= 0 ? 1 : -1;
+    }
+#pragma omp for schedule(static) nowait
+    for (int k = 0; k < nee; ++k) {
+      const int ea = ee[k].first, eb = ee[k].second;
+      const int i0 = edges_[ea][0], i1 = edges_[ea][1], j0 = edges_[eb][0], j1 = edges_[eb][1];
+      const Vec3 p1 = x.row(i0), q1 = x.row(i1), p2 = x.row(j0), q2 = x.row(j1);
+      double s = 0, t = 0;
+      closest_segments(p1, q1, p2, q2, s, t);
+      const Vec3 d = (p1 + s * (q1 - p1)) - (p2 + t * (q2 - p2));
+      double rel = 0;
+      for (int u : edges_[ea])
+        for (int w : edges_[eb]) rel = std::max(rel, (motion.row(u) - motion.row(w)).norm());
+      const double len = d.norm();
+      if (len >= thickness + rel + 2 * slack) continue;
+      ee_keep[k] = 1;
+      const Vec3 u = len > 0 ? Vec3(d / len) : Vec3::Zero();
+      ee_dir[k] = {static_cast<float>(u.x()), static_cast<float>(u.y()), static_cast<float>(u.z())};
+    }
+#pragma omp for schedule(static)
+    for (int k = 0; k < nef; ++k) {  // tangle test: an edge crossing a face
+      const int e = ef[k].first, f = ef[k].second;
+      ef_cross[k] = segment_crosses_triangle(x.row(edges_[e][0]), x.row(edges_[e][1]), x.row(F_(f, 0)), x.row(F_(f, 1)),
+                                             x.row(F_(f, 2)));
+    }
+  }
+  // Kept pairs in a fixed order (the broad phase's order is not).
+  for (int k = 0; k < nvf; ++k)
+    if (vt_keep[k]) vt_.push_back({vf[k].first, vf[k].second, vt_keep[k]});
+  for (int k = 0; k < nee; ++k)
+    if (ee_keep[k]) ee_.push_back({ee[k].first, ee[k].second, {ee_dir[k][0], ee_dir[k][1], ee_dir[k][2]}});
+  std::sort(vt_.begin(), vt_.end(), [](const VT& a, const VT& b) { return a.v != b.v ? a.v < b.v : a.f < b.f; });
+  vt_.erase(std::unique(vt_.begin(), vt_.end(), [](const VT& a, const VT& b) { return a.v == b.v && a.f == b.f; }),
+            vt_.end());
+  std::sort(ee_.begin(), ee_.end(), [](const EE& a, const EE& b) { return a.a != b.a ? a.a < b.a : a.b < b.b; });
+  ee_.erase(std::unique(ee_.begin(), ee_.end(), [](const EE& a, const EE& b) { return a.a == b.a && a.b == b.b; }),
+            ee_.end());
+  for (int k = 0; k < nef; ++k)
+    if (ef_cross[k]) {
+      ++intersecting_;
+      const int e = ef[k].first, f = ef[k].second;
+      tangled_[edges_[e][0]] = tangled_[edges_[e][1]] = 1;
+      for (int i = 0; i < 3; ++i) tangled_[F_(f, i)] = 1;
+    }
+}
+
+int SelfCollision::project(Points3& x, const std::vector<double>& winv, double thickness) {
+  int pushed = 0;
+  for (auto& c : vt_) {
+    const int ia = F_(c.f, 0), ib = F_(c.f, 1), ic = F_(c.f, 2);
+    const Vec3 p = x.row(c.v), a = x.row(ia), b = x.row(ib), cc = x.row(ic);
+    Vec3 bary, n;
+    double dist = 0;
+    if (!project_on_triangle(p, a, b, cc, bary, n, dist)) continue;
+    const bool free = tangled_[c.v] || tangled_[ia] || tangled_[ib] || tangled_[ic];
+    if (free || bary.minCoeff() < kInside) {  // crossing the plane is legal here: follow the geometry
+      if (dist != 0) c.side = dist > 0 ? 1 : -1;
+      continue;
+    }
+    const double C = c.side * dist - thickness;
+    if (C >= 0) continue;
+    const double wp = winv[c.v], wa = winv[ia], wb = winv[ib], wc = winv[ic];
+    const double wsum = wp + bary.x() * bary.x() * wa + bary.y() * bary.y() * wb + bary.z() * bary.z() * wc;
+    if (!(wsum > 0)) continue;
+    const Vec3 dir = (-C / wsum * c.side) * n;
+    x.row(c.v) += (wp * dir).transpose();
+    x.row(ia) -= (wa * bary.x() * dir).transpose();
+    x.row(ib) -= (wb * bary.y() * dir).transpose();
+    x.row(ic) -= (wc * bary.z() * dir).transpose();
+    ++pushed;
+  }
+  for (auto& c : ee_) {
+    const int i0 = edges_[c.a][0], i1 = edges_[c.a][1], j0 = edges_[c.b][0], j1 = edges_[c.b][1];
+    const Vec3 p1 = x.row(i0), q1 = x.row(i1), p2 = x.row(j0), q2 = x.row(j1);
+    double s = 0, t = 0;
+    closest_segments(p1, q1, p2, q2, s, t);
+    const Vec3 d = (p1 + s * (q1 - p1)) - (p2 + t * (q2 - p2));
+    const double len = d.norm();
+    Vec3 dir(c.dir[0], c.dir[1], c.dir[2]);
+    const bool free = tangled_[i0] || tangled_[i1] || tangled_[j0] || tangled_[j1];
+    const bool interior = s > kEdgeEnd && s < 1 - kEdgeEnd && t > kEdgeEnd && t < 1 - kEdgeEnd;
+    const double along = d.dot(dir);
+    if (free || !interior || dir.squaredNorm() == 0 || (along > 0 && len >= thickness)) {
+      // Free to move (or apart on the remembered side): the side follows the geometry.
+      if (len > 0) c.set_dir(d / len);
+      continue;
+    }
+    // Same side but too close: push along the current separation; crossed: push back
+    // along the remembered side.
+    Vec3 n = dir;
+    double C = along - thickness;
+    if (along > 0 && len > 0) {
+      n = d / len;
+      C = len - thickness;
+      c.set_dir(n);
+    }
+    const double w0 = winv[i0], w1 = winv[i1], w2 = winv[j0], w3 = winv[j1];
+    const double wsum = (1 - s) * (1 - s) * w0 + s * s * w1 + (1 - t) * (1 - t) * w2 + t * t * w3;
+    if (!(wsum > 0)) continue;
+    const Vec3 step = (-C / wsum) * n;
+    x.row(i0) += (w0 * (1 - s) * step).transpose();
+    x.row(i1) += (w1 * s * step).transpose();
+    x.row(j0) -= (w2 * (1 - t) * step).transpose();
+    x.row(j1) -= (w3 * t * step).transpose();
+    ++pushed;
+  }
+  return pushed;
+}
+
+}  // namespace sim

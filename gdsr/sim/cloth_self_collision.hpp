@@ -1,0 +1,90 @@
+// Cloth self-collision for the XPBD solver: vertex-triangle and edge-edge proximity
+// constraints that keep non-adjacent parts of the cloth at least `thickness` metres apart.
+//
+// Broad phase: Embree's rtcCollide (vertices against faces, edges against edges and against
+// faces for the tangle test) on boxes swept along each vertex's
+// predicted motion until the next detection and grown by a slack, so every pair that can
+// meet before the next detection is found (no tunnelling while each vertex stays within the
+// slack of its predicted path; the solver re-detects as soon as one leaves it). Narrow
+// phase: exact point-triangle and segment-segment distances against the pair's relative
+// motion, so cloth that moves along together does not pay for its speed.
+//
+// Side memory: each pair stores on which side of the triangle (vertex-triangle: sign along
+// the face normal) or of the other edge (edge-edge: the unit separation between the closest
+// points) it was when found, and the constraint pushes it back to that side. The side is
+// refreshed while crossing is legal (the vertex projects outside the triangle; the closest
+// points of the edges lie at an end) and, for edges, while they are apart on that side.
+//
+// Untangling: edges that already cross a triangle (an intersection that slipped through)
+// mark their and the triangle's vertices "tangled"; pairs touching a tangled vertex get no
+// constraint, and their side follows the geometry, so an intersection is never locked in:
+// stretch and bending pull the layers apart and the pair is guarded again once free.
+//
+// Pairs sharing a vertex are skipped (the mesh's own stretch and bending act there).
+//
+// Deterministic: candidate pairs are collected in any order (Embree, OpenMP), sorted, then
+// solved in that fixed order.
+#pragma once
+
+#include "gdsr/geometry/mesh.hpp"
+
+#include <algorithm>
+#include <array>
+#include <memory>
+#include <vector>
+
+namespace sim {
+
+class SelfCollision {
+ public:
+  // F: cloth triangles (indices into num_vertices welded vertices).
+  SelfCollision(const gdsr::Faces& F, int num_vertices);
+  ~SelfCollision();
+  SelfCollision(const SelfCollision&) = delete;
+  SelfCollision& operator=(const SelfCollision&) = delete;
+
+  // Finds every non-adjacent vertex-triangle and edge-edge pair that can come within
+  // `thickness` metres while each vertex v stays within `slack` metres of its path
+  // x.row(v) + a motion.row(v), a in [0, 1]; their sides are taken from x (assumed
+  // intersection-free except for tangled regions). tangle_test: also look for edges crossing
+  // triangles and refresh the tangled vertices (otherwise the last ones are kept).
+  void detect(const gdsr::Points3& x, const gdsr::Points3& motion, double slack, double thickness,
+              bool tangle_test = true);
+
+  // One Gauss-Seidel pass over the pairs (fixed order): pushes pairs closer than
+  // `thickness` apart along the triangle normal / edge-edge normal, by inverse masses winv
+  // (0 = fixed). Returns the number of pairs that were pushed.
+  int project(gdsr::Points3& x, const std::vector<double>& winv, double thickness);
+
+  int num_vertex_triangle() const { return static_cast<int>(vt_.size()); }
+  int num_edge_edge() const { return static_cast<int>(ee_.size()); }
+  // Vertices of edges and triangles found crossing each other at the last tangle test.
+  int num_tangled_vertices() const;
+  // Edge-triangle pairs (no shared vertex) found crossing at the last tangle test.
+  int num_intersecting_pairs() const { return intersecting_; }
+  long long num_detections() const { return detections_; }  // since construction
+
+ private:
+  struct VT {
+    int v, f;
+    signed char side;
+  };
+  struct EE {  // edge ids a < b; dir: unit separation (edge a minus edge b) on the remembered side
+    int a, b;
+    float dir[3];
+    void set_dir(const gdsr::Vec3& u) {
+      dir[0] = static_cast<float>(u.x()), dir[1] = static_cast<float>(u.y()), dir[2] = static_cast<float>(u.z());
+    }
+  };
+  gdsr::Faces F_;
+  std::vector<std::array<int, 2>> edges_;  // unique edges (i < j)
+  std::vector<VT> vt_;
+  std::vector<EE> ee_;
+  std::vector<char> tangled_;
+  int intersecting_ = 0;
+  long long detections_ = 0;
+  struct Embree;
+  std::unique_ptr<Embree> embree_;
+};
+
+}  // namespace sim

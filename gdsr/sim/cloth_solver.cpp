@@ -1,0 +1,424 @@
+#include "gdsr/sim/cloth_solver.hpp"
+
+#include "gdsr/error.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace sim {
+
+using gdsr::Points3;
+using gdsr::Vec2;
+using gdsr::Vec3;
+
+namespace {
+
+double cot(const Vec2& a, const Vec2& b) {  // cotangent of the angle between a and b
+  const double c = a.dot(b);
+  const double s = std::abs(a.x() * b.y() - a.y() * b.x());
+  return c / std::max(s, 1e-12);
+}
+
+double uv_area(const gdsr::GarmentMesh& m, int f) {
+  const Vec2 a = m.UV.row(m.FUV(f, 0)), b = m.UV.row(m.FUV(f, 1)), c = m.UV.row(m.FUV(f, 2));
+  const Vec2 e1 = b - a, e2 = c - a;
+  return 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+}
+
+Vec3 face_normal(const Points3& V, const gdsr::Faces& F, int f) {
+  const Vec3 a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+  const Vec3 n = (b - a).cross(c - a);
+  const double l = n.norm();
+  return l > 0 ? Vec3(n / l) : Vec3(0, 1, 0);
+}
+
+Vec3 bary_point(const Points3& V, const gdsr::Faces& F, int f, const Vec3& b) {
+  return b.x() * V.row(F(f, 0)).transpose() + b.y() * V.row(F(f, 1)).transpose() + b.z() * V.row(F(f, 2)).transpose();
+}
+
+}  // namespace
+
+ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Points3& body_V0, const SimParams& p)
+    : p_(p), F_(g.mesh.F), bodyF_(body_F), layer_(g.mesh.layer) {
+  const auto& m = g.mesh;
+  const int nv = static_cast<int>(m.V.rows());
+  if (nv == 0 || m.F.rows() == 0) gdsr::fail("sim/cloth_solver", "garment '" + g.name + "' is empty");
+  if (m.FUV.rows() != m.F.rows()) gdsr::fail("sim/cloth_solver", "garment F and FUV differ in face count");
+  if (p.substeps < 1 || p.iterations < 1 || p.contact_every < 1)
+    gdsr::fail("sim/cloth_solver", "substeps, iterations and contact_every must be >= 1");
+  if (!(p.density > 0) || !(p.stretch_stiffness > 0) || !(p.bend_stiffness > 0))
+    gdsr::fail("sim/cloth_solver", "density and stiffnesses must be positive");
+  if (body_F.rows() > 0 && body_F.maxCoeff() >= body_V0.rows())
+    gdsr::fail("sim/cloth_solver", "body faces index missing vertices");
+  if (!m.V.allFinite()) gdsr::fail("sim/cloth_solver", "garment rest positions are not finite");
+  if (!layer_.empty() && static_cast<int>(layer_.size()) != nv)
+    gdsr::fail("sim/cloth_solver", "garment layer size differs from vertex count");
+
+  x_ = m.V;
+  v_ = Points3::Zero(nv, 3);
+  xprev_ = x_;
+  mass_.assign(nv, 0.0);
+  for (int f = 0; f < m.F.rows(); ++f) {
+    const double a = uv_area(m, f);
+    for (int k = 0; k < 3; ++k) mass_[m.F(f, k)] += p.density * a / 3;
+  }
+  winv_.resize(nv);
+  for (int v = 0; v < nv; ++v) winv_[v] = mass_[v] > 0 ? 1.0 / mass_[v] : 0.0;
+
+  // Edges: rest length from the pattern (mean over the UV copies), area share for stiffness.
+  struct EdgeAcc {
+    double len = 0, area = 0;
+    int n = 0;
+    std::vector<std::pair<int, int>> faces;
+  };
+  std::map<std::pair<int, int>, EdgeAcc> emap;
+  for (int f = 0; f < m.F.rows(); ++f) {
+    const double a = uv_area(m, f);
+    for (int k = 0; k < 3; ++k) {
+      const int i = m.F(f, k), j = m.F(f, (k + 1) % 3);
+      auto& e = emap[{std::min(i, j), std::max(i, j)}];
+      e.len += (m.UV.row(m.FUV(f, k)) - m.UV.row(m.FUV(f, (k + 1) % 3))).norm();
+      e.area += a / 3;
+      ++e.n;
+      e.faces.push_back({f, k});
+    }
+  }
+  for (const auto& [key, e] : emap) {
+    const double rest = e.len / e.n;
+    if (!(rest > 1e-9)) gdsr::fail("sim/cloth_solver", "garment has a zero-length edge in UV");
+    edges_.push_back({key.first, key.second, rest, rest * rest / (p.stretch_stiffness * e.area)});
+    if (e.faces.size() != 2) continue;
+    // Isometric bending stencil: edge (x0, x1), opposite x2 (face 0) and x3 (face 1).
+    const int f0 = e.faces[0].first, k0 = e.faces[0].second;
+    const int f1 = e.faces[1].first;
+    const int x0 = m.F(f0, k0), x1 = m.F(f0, (k0 + 1) % 3), x2 = m.F(f0, (k0 + 2) % 3);
+    int k1 = 0;
+    while (m.F(f1, k1) == x0 || m.F(f1, k1) == x1) ++k1;
+    const int x3 = m.F(f1, k1);
+    auto uvof = [&](int f, int vert) {
+      for (int k = 0; k < 3; ++k)
+        if (m.F(f, k) == vert) return Vec2(m.UV.row(m.FUV(f, k)));
+      return Vec2(0, 0);
+    };
+    const Vec2 a0 = uvof(f0, x0), a1 = uvof(f0, x1), a2 = uvof(f0, x2);
+    const Vec2 b0 = uvof(f1, x0), b1 = uvof(f1, x1), b3 = uvof(f1, x3);
+    const double c01 = cot(a1 - a0, a2 - a0), c02 = cot(b1 - b0, b3 - b0);
+    const double c03 = cot(a0 - a1, a2 - a1), c04 = cot(b0 - b1, b3 - b1);
+    // Energy B |K x|^2 / (2 A): for a cylinder of curvature k it sums to B k^2 / 2 per area
+    // (the plate bending energy of the modulus B), checked in tests/sim/test_cantilever.cpp.
+    const double A = uv_area(m, f0) + uv_area(m, f1);
+    Bend b{{x0, x1, x2, x3}, {c03 + c04, c01 + c02, -c01 - c03, -c02 - c04}, A / p.bend_stiffness};
+    bends_.push_back(b);
+  }
+
+  // Body grid for the rest pose; initial push-out; pins.
+  const double cell = std::max(0.05, p.contact_radius + p.thickness);
+  if (body_F.rows() > 0) {
+    grid_.build(bodyF_, body_V0, body_V0, cell);
+    for (int v = 0; v < nv; ++v) {
+      const SurfaceHit hit = grid_.closest(x_.row(v).transpose(), body_V0, p.thickness + p.contact_radius);
+      if (hit.face >= 0 && hit.signed_distance < p.thickness)
+        x_.row(v) = (hit.point + hit.normal * p.thickness).transpose();
+    }
+  }
+  if (!g.pinned.empty() && body_F.rows() == 0) {  // no body: pinned vertices are fixed in space
+    for (int v : g.pinned) {
+      if (v < 0 || v >= nv) gdsr::fail("sim/cloth_solver", "pinned vertex out of range");
+      winv_[v] = 0;
+    }
+  } else if (!g.pinned.empty()) {
+    for (int v : g.pinned) {
+      if (v < 0 || v >= nv) gdsr::fail("sim/cloth_solver", "pinned vertex out of range");
+      SurfaceHit hit;
+      for (double r = 0.1; hit.face < 0 && r < 5; r *= 2) {
+        grid_.build(bodyF_, body_V0, body_V0, std::max(cell, r / 2));
+        hit = grid_.closest(m.V.row(v).transpose(), body_V0, r);
+      }
+      if (hit.face < 0) gdsr::fail("sim/cloth_solver", "pinned vertex is more than 5 m from the body");
+      const Vec3 p0 = body_V0.row(bodyF_(hit.face, 0)), p1 = body_V0.row(bodyF_(hit.face, 1));
+      const Vec3 n = face_normal(body_V0, bodyF_, hit.face);
+      const Vec3 t1 = (p1 - p0).normalized(), t2 = n.cross(t1);
+      const Vec3 d = m.V.row(v).transpose() - hit.point;
+      pins_.push_back({v, hit.face, hit.bary, Vec3(d.dot(t1), d.dot(t2), d.dot(n))});
+      winv_[v] = 0;
+    }
+    grid_.build(bodyF_, body_V0, body_V0, cell);
+    place_pins(body_V0);
+  }
+  body_cell_ = cell;
+  xprev_ = x_;
+  if (p.self_collision) {
+    if (!(p.self_thickness > 0) || p.self_detect_every < 1 || !(p.self_slack > 0) || p.self_passes < 1)
+      gdsr::fail("sim/cloth_solver",
+                 "self_thickness and self_slack must be positive, self_detect_every and self_passes >= 1");
+    self_ = std::make_unique<SelfCollision>(F_, nv);
+    motion_ = Points3::Zero(nv, 3);
+  }
+}
+
+Vec3 ClothSolver::pin_position(const Pin& pin, const Points3& body) const {
+  const Vec3 q = bary_point(body, bodyF_, pin.face, pin.bary);
+  const Vec3 p0 = body.row(bodyF_(pin.face, 0)), p1 = body.row(bodyF_(pin.face, 1));
+  const Vec3 n = face_normal(body, bodyF_, pin.face);
+  const Vec3 t1 = (p1 - p0).normalized(), t2 = n.cross(t1);
+  return q + pin.local.x() * t1 + pin.local.y() * t2 + pin.local.z() * n;
+}
+
+void ClothSolver::place_pins(const Points3& body) {
+  for (const auto& pin : pins_) x_.row(pin.v) = pin_position(pin, body).transpose();
+}
+
+void ClothSolver::refresh_contacts(const Points3& body_now) {
+  contacts_.clear();
+  const int nv = static_cast<int>(x_.rows());
+  if (bodyF_.rows() > 0) {
+    const double r = p_.thickness + p_.contact_radius;
+    for (int v = 0; v < nv; ++v) {
+      if (winv_[v] == 0) continue;
+      const SurfaceHit hit = grid_.closest(x_.row(v).transpose(), body_now, r);
+      // Deeper than max_push: the vertex went through a thin part or is pinched (e.g. between
+      // an arm and the pinned waistband); pushing it out would tear the cloth, so leave it.
+      if (hit.face >= 0 && hit.signed_distance > -p_.max_push) contacts_.push_back({v, hit.face, hit.bary});
+    }
+  }
+  layer_pairs_.clear();
+  if (layer_.empty()) return;
+  int nlayers = 1 + *std::max_element(layer_.begin(), layer_.end());
+  if (nlayers < 2) return;
+  // Vertex normals (area weighted) of the current cloth.
+  Points3 N = Points3::Zero(nv, 3);
+  for (int f = 0; f < F_.rows(); ++f) {
+    const Vec3 a = x_.row(F_(f, 0)), b = x_.row(F_(f, 1)), c = x_.row(F_(f, 2));
+    const Vec3 n = (b - a).cross(c - a);
+    for (int k = 0; k < 3; ++k) N.row(F_(f, k)) += n.transpose();
+  }
+  const double r = 2 * p_.layer_gap + 0.02;
+  std::unordered_map<long long, std::vector<int>> cells;
+  auto key = [](long long i, long long j, long long k) {
+    return ((i + (1 << 20)) * (1LL << 21) + (j + (1 << 20))) * (1LL << 21) + (k + (1 << 20));
+  };
+  for (int v = 0; v < nv; ++v) {
+    const Eigen::Vector3i c = (x_.row(v).transpose() / r).array().floor().cast<int>();
+    cells[key(c.x(), c.y(), c.z())].push_back(v);
+  }
+  for (int v = 0; v < nv; ++v) {
+    if (layer_[v] == 0) continue;
+    const Vec3 x = x_.row(v).transpose();
+    const Eigen::Vector3i c = (x / r).array().floor().cast<int>();
+    int best = -1;
+    double bd = r * r;
+    for (int i = -1; i <= 1; ++i)
+      for (int j = -1; j <= 1; ++j)
+        for (int k = -1; k <= 1; ++k) {
+          auto it = cells.find(key(c.x() + i, c.y() + j, c.z() + k));
+          if (it == cells.end()) continue;
+          for (int u : it->second) {
+            if (layer_[u] != layer_[v] - 1) continue;
+            const double d = (x_.row(u).transpose() - x).squaredNorm();
+            if (d < bd || (d == bd && u < best)) {
+              bd = d;
+              best = u;
+            }
+          }
+        }
+    if (best >= 0 && N.row(best).norm() > 0) layer_pairs_.push_back({v, best, N.row(best).normalized().transpose()});
+  }
+}
+
+void ClothSolver::detect_self_contacts(double h) {
+  // On the current (intersection-free) state, covering the motion of the next
+  // self_detect_every substeps; sooner when a vertex left its slack (track_self_slack).
+  if (!self_ || since_detect_ < p_.self_detect_every) return;
+  const int nv = static_cast<int>(x_.rows());
+  const double T = p_.self_detect_every * h;
+  for (int v = 0; v < nv; ++v)
+    motion_.row(v) = v_.row(v) * T + (winv_[v] == 0 ? 0.0 : 0.5 * T * T) * p_.gravity.transpose();
+  self_->detect(x_, motion_, p_.self_slack, p_.self_thickness);
+  x_detect_ = x_;
+  since_detect_ = 0;
+}
+
+void ClothSolver::predict(double h, double decay) {
+  xprev_ = x_;
+  const int nv = static_cast<int>(x_.rows());
+  for (int v = 0; v < nv; ++v) {
+    if (winv_[v] == 0) continue;
+    Vec3 vel = (v_.row(v).transpose() + h * p_.gravity) * decay;
+    const double sp = vel.norm();
+    if (sp > p_.max_speed) vel *= p_.max_speed / sp;
+    v_.row(v) = vel.transpose();
+    x_.row(v) += h * vel.transpose();
+  }
+}
+
+void ClothSolver::solve_edges(std::vector<double>& lambda_e, double h2) {
+  for (size_t c = 0; c < edges_.size(); ++c) {
+    const Edge& e = edges_[c];
+    const double wi = winv_[e.i], wj = winv_[e.j];
+    if (wi + wj == 0) continue;
+    Vec3 d = x_.row(e.i) - x_.row(e.j);
+    const double len = d.norm();
+    if (len < 1e-12) continue;
+    d /= len;
+    const double at = e.compliance / h2;
+    const double dl = (-(len - e.rest) - at * lambda_e[c]) / (wi + wj + at);
+    lambda_e[c] += dl;
+    x_.row(e.i) += (wi * dl) * d.transpose();
+    x_.row(e.j) -= (wj * dl) * d.transpose();
+  }
+}
+
+void ClothSolver::solve_bends(std::vector<double>& lambda_b, double h2) {
+  for (size_t c = 0; c < bends_.size(); ++c) {
+    const Bend& b = bends_[c];
+    Vec3 q = Vec3::Zero();
+    double wsum = 0;
+    for (int k = 0; k < 4; ++k) {
+      q += b.K[k] * x_.row(b.v[k]).transpose();
+      wsum += winv_[b.v[k]] * b.K[k] * b.K[k];
+    }
+    const double C = q.norm();
+    if (C < 1e-12 || wsum == 0) continue;
+    const Vec3 dir = q / C;
+    const double at = b.compliance / h2;
+    const double dl = (-C - at * lambda_b[c]) / (wsum + at);
+    lambda_b[c] += dl;
+    for (int k = 0; k < 4; ++k) x_.row(b.v[k]) += (winv_[b.v[k]] * b.K[k] * dl) * dir.transpose();
+  }
+}
+
+void ClothSolver::solve_layers() {
+  for (const auto& lp : layer_pairs_) {
+    const double wo = winv_[lp.outer], wi = winv_[lp.inner];
+    if (wo + wi == 0) continue;
+    const double C = (x_.row(lp.outer) - x_.row(lp.inner)).dot(lp.normal.transpose()) - p_.layer_gap;
+    if (C >= 0) continue;
+    x_.row(lp.outer) -= (wo * C / (wo + wi)) * lp.normal.transpose();
+    x_.row(lp.inner) += (wi * C / (wo + wi)) * lp.normal.transpose();
+  }
+}
+
+void ClothSolver::solve_body_contacts(const Points3& body_prev, const Points3& body_now) {
+  for (const auto& c : contacts_) {
+    const Vec3 q = bary_point(body_now, bodyF_, c.face, c.bary);
+    const Vec3 nrm = face_normal(body_now, bodyF_, c.face);
+    Vec3 x = x_.row(c.v).transpose();
+    const double C = (x - q).dot(nrm) - p_.thickness;
+    if (C >= 0) continue;
+    x -= C * nrm;
+    // Coulomb friction on the displacement relative to the body point this substep.
+    const Vec3 qprev = bary_point(body_prev, bodyF_, c.face, c.bary);
+    Vec3 rel = (x - xprev_.row(c.v).transpose()) - (q - qprev);
+    rel -= rel.dot(nrm) * nrm;
+    const double rl = rel.norm();
+    const double lim = p_.friction * (-C);
+    if (rl > 0) x -= (rl <= lim ? 1.0 : lim / rl) * rel;
+    x_.row(c.v) = x.transpose();
+  }
+}
+
+void ClothSolver::solve_self_contacts() {
+  // After body contact: cloth folded against the body keeps its layers apart (thickness
+  // margin) instead of being pressed onto one surface. A few passes: contacts share
+  // vertices, and one Gauss-Seidel pass leaves them coupled.
+  if (!self_) return;
+  for (int k = 0; k < p_.self_passes && self_->project(x_, winv_, p_.self_thickness) > 0; ++k) {
+  }
+}
+
+void ClothSolver::update_velocities(double h) {
+  const int nv = static_cast<int>(x_.rows());
+  for (int v = 0; v < nv; ++v) v_.row(v) = (x_.row(v) - xprev_.row(v)) / h;
+}
+
+void ClothSolver::track_self_slack() {
+  // Re-detect early when a vertex left the slack around its predicted path.
+  if (!self_) return;
+  ++since_detect_;
+  const int nv = static_cast<int>(x_.rows());
+  const double a = static_cast<double>(since_detect_) / p_.self_detect_every;
+  const double s2 = p_.self_slack * p_.self_slack;
+  for (int v = 0; v < nv && since_detect_ < p_.self_detect_every; ++v)
+    if ((x_.row(v) - x_detect_.row(v) - a * motion_.row(v)).squaredNorm() > s2) since_detect_ = p_.self_detect_every;
+}
+
+void ClothSolver::step(const Points3& body_from, const Points3& body_to, double dt) {
+  if (!(dt > 0)) gdsr::fail("sim/cloth_solver", "frame time must be positive");
+  const bool has_body = bodyF_.rows() > 0;
+  if (has_body && (body_from.rows() != body_to.rows() || body_from.rows() <= bodyF_.maxCoeff()))
+    gdsr::fail("sim/cloth_solver", "body pose vertex count does not match the body faces");
+  const int n = p_.substeps;
+  const double h = dt / n;
+  const double h2 = h * h;
+  if (has_body) grid_.build(bodyF_, body_from, body_to, body_cell_);
+  Points3 body_prev = body_from, body_now = body_from;
+  const double decay = std::exp(-p_.damping * h);
+  std::vector<double> lambda_e(edges_.size()), lambda_b(bends_.size());
+
+  for (int s = 0; s < n; ++s) {
+    // The body moves linearly from body_from to body_to over the frame.
+    if (has_body) {
+      body_prev = body_now;
+      const double a = static_cast<double>(s + 1) / n;
+      body_now = (1 - a) * body_from + a * body_to;
+      if (s % p_.contact_every == 0) refresh_contacts(body_prev);
+    } else if (s % p_.contact_every == 0) {
+      refresh_contacts(body_now);
+    }
+    detect_self_contacts(h);
+    predict(h, decay);
+    if (has_body) place_pins(body_now);
+    std::fill(lambda_e.begin(), lambda_e.end(), 0.0);
+    std::fill(lambda_b.begin(), lambda_b.end(), 0.0);
+    for (int it = 0; it < p_.iterations; ++it) {
+      solve_edges(lambda_e, h2);
+      solve_bends(lambda_b, h2);
+      solve_layers();
+      solve_body_contacts(body_prev, body_now);
+      solve_self_contacts();
+    }
+    update_velocities(h);
+    track_self_slack();
+  }
+  if (!x_.allFinite()) gdsr::fail("sim/cloth_solver", "simulation produced non-finite positions");
+}
+
+std::vector<Points3> simulate_frames(const Garment& g, const gdsr::Faces& body_F, const std::vector<Points3>& frames,
+                                     double fps, const SimParams& p, const gdsr::ProgressFn& progress) {
+  if (frames.empty()) gdsr::fail("sim/cloth_solver", "no body frames");
+  if (!(fps > 0)) gdsr::fail("sim/cloth_solver", "fps must be positive");
+  for (size_t t = 0; t < frames.size(); ++t)
+    if (frames[t].rows() != frames[0].rows() || !frames[t].allFinite())
+      gdsr::fail("sim/cloth_solver",
+                 "body frame " + std::to_string(t) + " has a different vertex count or non-finite values");
+  ClothSolver solver(g, body_F, frames[0], p);
+  const double dt = 1.0 / fps;
+  const int total = static_cast<int>(frames.size()) + p.settle_frames;
+  int done = 0;
+  for (int k = 0; k < p.settle_frames; ++k) {
+    solver.step(frames[0], frames[0], dt);
+    solver.zero_velocities();  // relax the rest placement quasi-statically
+    if (progress) progress(++done, total);
+  }
+  std::vector<Points3> out;
+  out.reserve(frames.size());
+  out.push_back(solver.positions());
+  if (progress) progress(++done, total);
+  for (size_t t = 1; t < frames.size(); ++t) {
+    try {
+      solver.step(frames[t - 1], frames[t], dt);
+    } catch (const std::runtime_error& e) {
+      gdsr::fail("sim/cloth_solver", "frame " + std::to_string(t) + ": " + e.what());
+    }
+    out.push_back(solver.positions());
+    if (progress) progress(++done, total);
+  }
+  return out;
+}
+
+}  // namespace sim

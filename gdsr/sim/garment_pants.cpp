@@ -1,0 +1,78 @@
+// Long pants: front and back panels like the shorts (garment_tubes.cpp), with legs down to
+// the ankles that taper to a hem of ~15 cm diameter. Each leg tube follows the body's leg
+// from the crotch to the ankle (spread legs tilt it), so the legs clear the body; above
+// the crotch the tubes blend into the hip cylinder. Side seams and inseams; the waistband
+// is pinned.
+#include "gdsr/sim/garment_design.hpp"
+#include "gdsr/sim/garment_legs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace sim {
+
+using gdsr::Vec2;
+using gdsr::Vec3;
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}
+
+GarmentDesign design_pants(const BodyLandmarks& lm) {
+  const double s = lm.height / 1.75;
+  const Vec3 axis = lm.axis;
+  GarmentDesign d;
+  Pattern& p = d.pattern;
+  const double R = lm.hip_r + 0.03 * s;
+  const double W = kPi * R;
+  const double hem_y = lm.ankle_y + 0.015 * s;
+  const double Htot = lm.waist_y - hem_y;
+  const double Hc = lm.crotch_y - 0.03 * s - hem_y;
+  const double r_hem = 0.075 * s;
+  const double g = std::max(0.02 * s, W / 2 - kPi * r_hem), blend = 0.10 * s;
+  std::vector<Vec2> o{Vec2(-W / 2, 0), Vec2(-g, 0),       Vec2(0, Hc),       Vec2(g, 0),
+                      Vec2(W / 2, 0),  Vec2(W / 2, Htot), Vec2(-W / 2, Htot)};
+  p.panels.push_back({"pants_front", o});
+  for (auto& v : o) v.x() += W + 0.1;
+  p.panels.push_back({"pants_back", o});
+  p.seams.push_back({0, 4, 1, 6, true});  // side seams
+  p.seams.push_back({1, 4, 0, 6, true});
+  p.seams.push_back({0, 1, 1, 2, true});  // inseams
+  p.seams.push_back({0, 2, 1, 1, true});
+  // Each leg tube is a tilted cone around the body leg's line (from `top` at the crotch
+  // height, R/2 to the side, to the leg's centre near the ankle); below the top quarter its
+  // cross-sections are perpendicular to that line (e1 outwards, e2 forwards), so the
+  // placement stays isometric there.
+  Vec3 top[2], dir[2], e1[2], e2[2];
+  for (int k = 0; k < 2; ++k) {
+    const double side = k == 0 ? 1.0 : -1.0;
+    top[k] = Vec3(side * R / 2, hem_y + Hc, 0);
+    const Vec3 dl = lm.leg_bottom[k] - lm.leg_top[k];
+    Vec3 bot = lm.leg_top[k] + dl * ((hem_y - lm.leg_top[k].y()) / (dl.y() < -1e-6 ? dl.y() : -1.0)) - axis;
+    bot.y() = hem_y;
+    bot.x() = side * std::max(side * bot.x(), r_hem + 0.01 * s);  // keep the tubes apart
+    dir[k] = (bot - top[k]).normalized();                         // downwards along the leg
+    e1[k] = (side * Vec3::UnitX() - dir[k] * (side * dir[k].x())).normalized();
+    e2[k] = (Vec3::UnitZ() - dir[k] * dir[k].z() - e1[k] * e1[k].z()).normalized();
+  }
+  d.place = [=](int panel, const Vec2& uv) {
+    const LegCoords lc = leg_coords(panel, uv, W, R, hem_y, Hc, g, blend);
+    if (lc.on_hip) return Vec3(axis + lc.hip);
+    const double y = uv.y(), t = lc.t, r = lc.r, zs = lc.zs;
+    const int k = lc.leg;  // 3-D side of this leg
+    const double side = k == 0 ? 1.0 : -1.0;
+    const Vec3 c = top[k] + dir[k] * std::max(0.0, Hc - y);  // vertical above the crotch (blend zone)
+    // Cross-sections horizontal at the crotch (the two tubes touch only at the crotch point
+    // there), turning perpendicular to the leg line within the top quarter of the leg.
+    const double w = std::clamp((Hc - y) / (0.25 * Hc), 0.0, 1.0);
+    const Vec3 f1 = ((1 - w) * side * Vec3::UnitX() + w * e1[k]).normalized();
+    const Vec3 f2 = ((1 - w) * Vec3::UnitZ() + w * e2[k]).normalized();
+    const Vec3 leg = c + r * std::cos(kPi * t) * f1 + zs * r * std::sin(kPi * t) * f2;
+    return Vec3(axis + (1 - lc.blend) * leg + lc.blend * lc.hip);
+  };
+  d.pinned = [Htot](int, const Vec2& uv) { return uv.y() > Htot - 1e-9; };  // waistband
+  return d;
+}
+
+}  // namespace sim

@@ -1,0 +1,39 @@
+#include "infer/cmd_rollout_common.hpp"
+
+#include "gdsr/cli/progress_bar.hpp"
+#include "gdsr/model/gdsr_model.hpp"
+#include "gdsr/model/model_checkpoint.hpp"
+#include "nn/checkpoint.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+
+namespace gdsr_cli {
+
+gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d) {
+  gdsr::GDSR<float> model(gdsr::config_from_checkpoint(a.model));
+  nn::load_checkpoint<float>(a.model, model, nullptr);
+  gdsr::RolloutOptions opt = a.opt;
+  opt.collisions = !a.no_collisions;
+  gdsr::ProgressBar bar("roll-out");
+  gdsr::RolloutResult r = gdsr::rollout(model, d, opt, bar.callback());
+  bar.finish();
+  int pushed = 0;
+  for (const auto& c : r.collisions) pushed += c.hr_body + c.hr_layer;
+  std::printf(
+      "rolled out %zu frames: %.3f s/frame (model %.3f s), LR %lld -> HR %lld vertices, %d HR vertices "
+      "moved by collision handling\n",
+      r.G.size(), r.seconds_per_frame, r.model_seconds_per_frame, static_cast<long long>(d.lr_frames[0].rows()),
+      static_cast<long long>(d.hr_frames[0].rows()), pushed);
+  return r;
+}
+
+void add_rollout_options(CLI::App* c, RolloutArgs& a) {
+  c->add_option("--data", a.data, "dataset folder (LR input; HR for eval)")->required();
+  c->add_option("--first", a.opt.first_frame, "first frame")->capture_default_str();
+  c->add_option("--frames", a.opt.frames, "number of frames (-1: to the end)")->capture_default_str();
+  c->add_flag("--no-collisions", a.no_collisions, "skip the explicit collision handling");
+}
+
+}  // namespace gdsr_cli

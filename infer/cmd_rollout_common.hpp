@@ -1,0 +1,30 @@
+// Shared by `gdsr infer` and `gdsr eval`: their common options and the roll-out of a
+// checkpoint over a dataset, printed as it goes.
+#pragma once
+
+#include "gdsr/data/dataset.hpp"
+#include "infer/rollout.hpp"
+
+#include <string>
+
+namespace CLI {
+class App;
+}
+
+namespace gdsr_cli {
+
+struct RolloutArgs {
+  std::string model, data, out = "runs/infer", pred;
+  gdsr::RolloutOptions opt;
+  bool no_collisions = false;
+  int obj_every = 0;
+  int ssim_every = 1;
+};
+
+// Loads the checkpoint a.model, rolls it out over d with a progress bar, prints a summary.
+gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d);
+
+// --data, --first, --frames, --no-collisions.
+void add_rollout_options(CLI::App* c, RolloutArgs& a);
+
+}  // namespace gdsr_cli

@@ -1,0 +1,135 @@
+#include "infer/collision.hpp"
+
+#include "gdsr/error.hpp"
+
+#include "gdsr/body/body_query.hpp"
+#include "gdsr/geometry/mesh_ops.hpp"
+
+#include <nanoflann.hpp>
+
+#include <algorithm>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace gdsr {
+
+namespace {
+
+// A subset of rows of a Points3 as a nanoflann point cloud.
+struct SubsetCloud {
+  const Points3* P = nullptr;
+  std::vector<int> rows;
+  size_t kdtree_get_point_count() const { return rows.size(); }
+  double kdtree_get_pt(size_t i, size_t d) const { return (*P)(rows[i], static_cast<int>(d)); }
+  template <class BBox> bool kdtree_get_bbox(BBox&) const { return false; }
+};
+using SubsetTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, SubsetCloud>, SubsetCloud, 3, uint32_t>;
+
+// HR vertices grouped by their nearest LR vertex (CSR).
+struct Groups {
+  std::vector<int> offsets, items;
+};
+Groups group_hr(const std::vector<int>& nearest, int num_lr) {
+  Groups g;
+  g.offsets.assign(static_cast<size_t>(num_lr) + 1, 0);
+  for (int i : nearest) ++g.offsets[i + 1];
+  for (int i = 0; i < num_lr; ++i) g.offsets[i + 1] += g.offsets[i];
+  g.items.resize(nearest.size());
+  std::vector<int> fill(g.offsets.begin(), g.offsets.end() - 1);
+  for (size_t k = 0; k < nearest.size(); ++k) g.items[fill[nearest[k]]++] = static_cast<int>(k);
+  return g;
+}
+
+// Moves the HR vertices of LR vertex i out of the plane (p, n) to offset sigma; returns moved count.
+int push_group(const Groups& g, int i, const Vec3& p, const Vec3& n, double sigma, Points3& G) {
+  int moved = 0;
+  for (int k = g.offsets[i]; k < g.offsets[i + 1]; ++k) {
+    const int v = g.items[k];
+    const Vec3 x = G.row(v).transpose();
+    const double m = sigma - (x - p).dot(n);
+    if (m > 0) {
+      G.row(v) = (x + m * n).transpose();
+      ++moved;
+    }
+  }
+  return moved;
+}
+
+}  // namespace
+
+BodyQueryFn body_query_fn(const BodyQuery& body) {
+  return [&body](const Points3& q, Points3& closest, Points3& normal) {
+    ClosestPoints c = body.closest(q, true);
+    closest = std::move(c.point);
+    normal = std::move(c.normal);
+  };
+}
+
+CollisionStats resolve_collisions(const CollisionConfig& cfg, const CollisionInput& in, Points3& G) {
+  if (in.C_hat == nullptr || in.hr_nearest_lr == nullptr)
+    gdsr::fail("collision", "C_hat and hr_nearest_lr are required");
+  const Points3& C = *in.C_hat;
+  const int nl = static_cast<int>(C.rows());
+  const std::vector<int>& nearest = *in.hr_nearest_lr;
+  if (static_cast<int64_t>(nearest.size()) != G.rows())
+    gdsr::fail("collision", "hr_nearest_lr has " + std::to_string(nearest.size()) + " entries for " +
+                                std::to_string(G.rows()) + " HR vertices");
+  for (int i : nearest)
+    if (i < 0 || i >= nl) gdsr::fail("collision", "hr_nearest_lr entry " + std::to_string(i) + " out of range");
+  CollisionStats st;
+  const bool do_body = cfg.body && in.body != nullptr && *in.body;
+  const bool multi_layer = in.lr_layer != nullptr && !in.lr_layer->empty() &&
+                           *std::max_element(in.lr_layer->begin(), in.lr_layer->end()) > 0;
+  const bool do_layers = cfg.layers && multi_layer;
+  if (!do_body && !do_layers) return st;
+  const Groups groups = group_hr(nearest, nl);
+
+  if (do_body) {
+    Points3 b(nl, 3), n(nl, 3);
+    (*in.body)(C, b, n);
+    if (b.rows() != nl || n.rows() != nl) gdsr::fail("collision", "body query returned the wrong number of rows");
+    st.body_queried = true;
+    for (int i = 0; i < nl; ++i) {
+      const Vec3 p = b.row(i).transpose(), nb = n.row(i).transpose();
+      if (cfg.sigma_b - (C.row(i).transpose() - p).dot(nb) > 0) {
+        ++st.lr_body;
+        st.hr_body += push_group(groups, i, p, nb, cfg.sigma_b, G);
+      }
+    }
+  }
+
+  if (do_layers) {
+    const std::vector<int>& layer = *in.lr_layer;
+    if (static_cast<int>(layer.size()) != nl) gdsr::fail("collision", "lr_layer size differs from the LR vertex count");
+    if (in.lr_F == nullptr) gdsr::fail("collision", "lr_F is required for layer collisions");
+    st.layers_checked = true;
+    const Points3 N = vertex_normals(C, *in.lr_F);
+    const int top = *std::max_element(layer.begin(), layer.end());
+    for (int L = 1; L <= top; ++L) {
+      SubsetCloud cloud;
+      cloud.P = &C;
+      for (int i = 0; i < nl; ++i)
+        if (layer[i] < L) cloud.rows.push_back(i);
+      if (cloud.rows.empty()) continue;
+      SubsetTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+      for (int e = 0; e < nl; ++e) {
+        if (layer[e] != L) continue;
+        uint32_t idx = 0;
+        double d2 = 0;
+        const double q[3] = {C(e, 0), C(e, 1), C(e, 2)};
+        if (tree.knnSearch(q, 1, &idx, &d2) < 1) continue;
+        const int i = cloud.rows[idx];
+        const Vec3 ci = C.row(i).transpose(), ni = N.row(i).transpose();
+        if (d2 < cfg.gamma * cfg.gamma && cfg.sigma_l - (C.row(e).transpose() - ci).dot(ni) > 0) {
+          ++st.lr_layer;
+          st.hr_layer += push_group(groups, e, ci, ni, cfg.sigma_l, G);
+        }
+      }
+    }
+  }
+  return st;
+}
+
+}  // namespace gdsr

@@ -1,0 +1,44 @@
+// Evaluation of predicted HR sequences against the HR simulation (paper 5, appendices B-C):
+// vertex error, SSIM of UV normal maps, and the stretch / shear energies of appendix B.
+#pragma once
+
+#include "gdsr/io/progress.hpp"
+#include "gdsr/data/dataset.hpp"
+#include "gdsr/geometry/strain.hpp"
+
+#include <opencv2/core.hpp>
+
+#include <vector>
+
+namespace gdsr {
+
+// UV normal map of an HR frame: each raster pixel coloured 0.5 n + 0.5 with n the
+// barycentric interpolation of the area-weighted vertex normals of its triangle (not
+// renormalised, as in training); background black. CV_32FC3 in 0..1, RGB = xyz.
+cv::Mat uv_normal_map(const UVRaster& raster, const Faces& F, const Points3& V);
+
+// Mean SSIM over the three channels (OpenCV quality module, Gaussian window 11, sigma 1.5)
+// of two CV_32FC3 images with values in 0..1.
+double ssim(const cv::Mat& a, const cv::Mat& b);
+
+struct FrameEvaluation {
+  int frame = 0;
+  double error = 0;         // mean |G - G*| over HR vertices, metres
+  double error_lr = 0;      // the same for the LR simulation upsampled (baseline)
+  double ssim = 0;          // normal maps of G vs G*
+  double ssim_lr = 0;       // normal maps of the upsampled LR vs G*
+  StrainEnergies energies;  // of G
+};
+
+struct Evaluation {
+  std::vector<FrameEvaluation> frames;
+  FrameEvaluation mean;  // averages (frame = -1)
+  StrainEnergies truth;  // of the ground truth, averaged over the same frames
+};
+
+// G: predicted HR frames for frames first_frame, first_frame + 1, ... of d.
+// ssim_every: compute SSIM on every k-th frame (normal maps of 1024^2 pixels cost ~0.1 s).
+Evaluation evaluate(const Dataset& d, const std::vector<Points3>& G, int first_frame, int ssim_every = 1,
+                    const ProgressFn& progress = {});
+
+}  // namespace gdsr

@@ -1,0 +1,71 @@
+#include "infer/rollout.hpp"
+
+#include "gdsr/error.hpp"
+
+#include "autograd/tensor.hpp"
+#include "gdsr/data/frame_input.hpp"
+#include "gdsr/model/frames.hpp"
+
+#include <chrono>
+#include <stdexcept>
+
+namespace gdsr {
+
+RolloutResult rollout(const GDSR<float>& model, const Dataset& d, const RolloutOptions& opt,
+                      const ProgressFn& progress) {
+  const int T = static_cast<int>(d.lr_frames.size());
+  if (opt.first_frame < 0 || opt.first_frame >= T)
+    gdsr::fail("rollout", "first frame " + std::to_string(opt.first_frame) + " outside 0.." + std::to_string(T - 1));
+  const int count = opt.frames < 0 ? T - opt.first_frame : std::min(opt.frames, T - opt.first_frame);
+  ag::NoGradGuard no_grad;
+  const GarmentGraph graph = build_graph(d.lr);
+  const HrRequest all = hr_request_all(d.corr);
+  std::unique_ptr<BodyQuery> body = make_body_query(d);
+
+  RolloutResult r;
+  r.first_frame = opt.first_frame;
+  double model_secs = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < count; ++k) {
+    const int t = opt.first_frame + k;
+    // Before any prediction exists the history is the LR simulation itself (d = 0).
+    const Points3& h1 = k >= 1 ? r.C_hat[k - 1] : d.lr_frames[std::max(t - 1, 0)];
+    const Points3& h2 =
+        k >= 2 ? r.C_hat[k - 2] : (k == 1 ? d.lr_frames[std::max(t - 1, 0)] : d.lr_frames[std::max(t - 2, 0)]);
+    const FrameInput in = make_frame_input(d, t, h1, h2, body.get());
+    const auto m0 = std::chrono::steady_clock::now();
+    const GdsrOutput<float> out = model.forward(graph, in, &all);
+    model_secs += std::chrono::duration<double>(std::chrono::steady_clock::now() - m0).count();
+    Points3 C_hat = to_points(out.C_hat);
+    Points3 G = to_points(out.G);
+
+    CollisionStats stats;
+    if (opt.collisions) {
+      BodyQueryFn query;
+      if (body) {
+        query = [&body](const Points3& q, Points3& closest, Points3& normal) {
+          const ClosestPoints cp = body->closest(q);  // body is at frame t already
+          closest = cp.point;
+          normal = cp.normal;
+        };
+      }
+      CollisionInput ci;
+      ci.C_hat = &C_hat;
+      ci.lr_F = &d.lr.F;
+      ci.lr_layer = &d.lr.layer;
+      ci.hr_nearest_lr = &d.corr.hr_nearest_lr;
+      ci.body = body ? &query : nullptr;
+      stats = resolve_collisions(opt.collision, ci, G);
+    }
+    r.C_hat.push_back(std::move(C_hat));
+    r.G.push_back(std::move(G));
+    r.collisions.push_back(stats);
+    if (progress) progress(k + 1, count);
+  }
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.seconds_per_frame = count ? secs / count : 0.0;
+  r.model_seconds_per_frame = count ? model_secs / count : 0.0;
+  return r;
+}
+
+}  // namespace gdsr

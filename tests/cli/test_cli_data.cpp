@@ -1,0 +1,166 @@
+// Runs the built gdsr binary on bad input: every failure is one line "gdsr: error: ..." on
+// stderr and a non-zero exit status.
+#include "gdsr/geometry/mesh_ops.hpp"
+#include "gdsr/geometry/obj_io.hpp"
+#include "tests/support/data_fixtures.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <sys/wait.h>
+
+using gdsr_test::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  int status = -1;
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+Run gdsr_run(const TempDir& dir, const std::string& args) {
+  const std::string out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string cmd = std::string("'") + GDSR_BINARY_DIR + "/gdsr' " + args + " >'" + out + "' 2>'" + err + "'";
+  const int rc = std::system(cmd.c_str());
+  Run r;
+  r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+int count_lines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+// Progress lines (stderr is not a terminal here) may precede the error; the error itself is
+// the last line, exactly one line.
+void check_one_line_error(const Run& r, const std::string& needle) {
+  CHECK(r.status == 1);
+  REQUIRE(!r.err.empty());
+  CHECK(r.err.back() == '\n');
+  const size_t start = r.err.rfind('\n', r.err.size() - 2);
+  const std::string last = r.err.substr(start == std::string::npos ? 0 : start + 1);
+  CHECK(last.rfind("gdsr: error: ", 0) == 0);
+  CHECK(count_lines(r.err.substr(r.err.find("gdsr: error: "))) == 1);
+  CHECK(last.find(needle) != std::string::npos);
+  if (last.find(needle) == std::string::npos) MESSAGE("stderr: " << r.err);
+}
+
+// MD-style exports of a small tube: LR/HR frame folders and flattened OBJs.
+void write_md_exports(const TempDir& dir, int lr_frames, int hr_frames) {
+  const gdsr::GarmentMesh lr = gdsr_test::grid_garment(gdsr_test::GridSpec(6, 3, 0.6, 0.3).tube());
+  const gdsr::GarmentMesh hr = gdsr::subdivide_midpoint(lr);
+  auto flat = [](const gdsr::GarmentMesh& g) {
+    gdsr::TriMesh m{gdsr::Points3::Zero(g.UV.rows(), 3), g.FUV};
+    m.V.leftCols(2) = g.UV;
+    return m;
+  };
+  fs::create_directories(dir / "lr");
+  fs::create_directories(dir / "hr");
+  gdsr::write_obj(dir / "lr_flat.obj", flat(lr));
+  gdsr::write_obj(dir / "hr_flat.obj", flat(hr));
+  for (int t = 0; t < lr_frames; ++t)
+    gdsr::write_obj(dir / ("lr/f" + std::to_string(t) + ".obj"), gdsr::TriMesh{lr.V, lr.F});
+  for (int t = 0; t < hr_frames; ++t)
+    gdsr::write_obj(dir / ("hr/f" + std::to_string(t) + ".obj"), gdsr::TriMesh{hr.V, hr.F});
+}
+
+std::string import_args(const TempDir& dir) {
+  return "data import-md --lr-dir '" + (dir / "lr") + "' --hr-dir '" + (dir / "hr") + "' --lr-uv '" +
+         (dir / "lr_flat.obj") + "' --hr-uv '" + (dir / "hr_flat.obj") + "' --out '" + (dir / "out") + "'";
+}
+
+}  // namespace
+
+TEST_CASE("cli data: import-md then check succeeds") {
+  TempDir dir("cli_ok");
+  write_md_exports(dir, 3, 3);
+  const Run imp = gdsr_run(dir, import_args(dir));
+  CHECK(imp.status == 0);
+  CHECK(imp.out.find("3 frames") != std::string::npos);
+  const Run chk = gdsr_run(dir, "data check --data '" + (dir / "out") + "'");
+  CHECK(chk.status == 0);
+  CHECK(chk.out.find("ok") != std::string::npos);
+  // The validity figures of the (static, clean) import: no body to measure penetration against.
+  CHECK(chk.out.find("validity over 3 frames") != std::string::npos);
+  CHECK(chk.out.find("self-intersection: frames with 0 pairs") != std::string::npos);
+  CHECK(chk.out.find("100.0%") != std::string::npos);
+  CHECK(chk.out.find("strain: mean E_u") != std::string::npos);
+  CHECK(chk.out.find("not measured") != std::string::npos);
+  CHECK(chk.out.find("agreement") != std::string::npos);
+  CHECK(chk.out.find("no validity figures stored") != std::string::npos);
+  if (chk.out.find("validity over") == std::string::npos) MESSAGE("stdout: " << chk.out);
+  const Run strided = gdsr_run(dir, "data check --intersection-stride 2 --data '" + (dir / "out") + "'");
+  CHECK(strided.status == 0);
+  CHECK(strided.out.find("1 frame in 2: 2 checked") != std::string::npos);
+}
+
+TEST_CASE("cli data: bad input gives a one-line error and exit 1") {
+  TempDir dir("cli_bad");
+  write_md_exports(dir, 3, 2);
+  check_one_line_error(gdsr_run(dir, import_args(dir)), "mismatched frame counts");
+
+  write_md_exports(dir, 3, 3);
+  std::ofstream(dir / "hr/f1.obj") << "v 0 0 0\nv 1 0 0\nf 1 2 x\n";
+  check_one_line_error(gdsr_run(dir, import_args(dir)), "f1.obj:3");
+
+  std::ofstream(dir / "hr/f1.obj", std::ios::trunc) << "";
+  check_one_line_error(gdsr_run(dir, import_args(dir)), "empty mesh");
+
+  std::ofstream(dir / "hr/f1.obj", std::ios::trunc) << "v 0 NaN 0\n";
+  check_one_line_error(gdsr_run(dir, import_args(dir)), "non-finite");
+
+  check_one_line_error(gdsr_run(dir, "data check --data '" + (dir / "missing") + "'"), "no dataset folder");
+  check_one_line_error(gdsr_run(dir, "data frobnicate"), "");
+  CHECK_FALSE(fs::exists(dir / "out"));
+}
+
+TEST_CASE("cli data: make a tiny dataset, check it and preview a frame") {
+  // Coarse particle distances and 0.2 s of motion keep this to a few seconds.
+  TempDir dir("cli_make");
+  const std::string out = dir / "ds";
+  const Run mk = gdsr_run(dir, "data make --garment skirt_short --out '" + out +
+                                   "' --seconds 0.2 --lr-pd 0.06 --hr-pd 0.03 --rest-blend 3 --raster 128");
+  REQUIRE(mk.status == 0);
+  CHECK(mk.out.find("vertices: LR") != std::string::npos);
+  CHECK(mk.out.find("seconds per frame") != std::string::npos);
+  CHECK(mk.out.find("penetration") != std::string::npos);
+  CHECK(mk.out.find("self-intersection: median pairs") != std::string::npos);
+  CHECK(fs::exists(out + "/manifest.json"));
+  CHECK_FALSE(fs::exists(out + ".tmp"));
+  const Run chk = gdsr_run(dir, "data check --data '" + out + "'");
+  CHECK(chk.status == 0);
+  CHECK(chk.out.find("garment skirt_short") != std::string::npos);
+  // `data check` recomputes the figures `data make` stored: the same numbers.
+  CHECK(chk.out.find("body: max penetration") != std::string::npos);
+  CHECK(chk.out.find("stored validity figures agree with the recomputed ones") != std::string::npos);
+  if (chk.out.find("agree with the") == std::string::npos) MESSAGE("stdout: " << chk.out);
+  const Run pv =
+      gdsr_run(dir, "data preview --data '" + out + "' --frame 5 --size 128 --out '" + (dir / "p.png") + "'");
+  CHECK(pv.status == 0);
+  CHECK(fs::file_size(dir / "p.png") > 1000);
+  const Run pvi =
+      gdsr_run(dir, "data preview --data '" + out + "' --intersections --size 128 --out '" + (dir / "pi.png") + "'");
+  CHECK(pvi.status == 0);
+  CHECK(fs::file_size(dir / "pi.png") > 1000);
+  check_one_line_error(gdsr_run(dir, "data preview --data '" + out + "' --frame 999 --out '" + (dir / "q.png") + "'"),
+                       "out of range");
+  check_one_line_error(gdsr_run(dir, "data make --garment skirt_short --motion '" + (dir / "none.bvh") + "' --out '" +
+                                         (dir / "x") + "'"),
+                       "none.bvh");
+  check_one_line_error(gdsr_run(dir, "data make --garment no_such_garment --out '" + (dir / "x") + "'"), "garment");
+}

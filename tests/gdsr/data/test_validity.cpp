@@ -1,0 +1,154 @@
+// Validity figures of synthetic datasets whose answers are known in closed form: a sheet
+// stretched 10% along u (E_u = 0.01), HR lifted 2 mm off the LR (agreement 2 mm), a box body
+// rising through the sheet (known depths), and an HR frame wrapped 1.25 times round a cylinder
+// (self-overlap).
+#include "gdsr/data/validity.hpp"
+#include "gdsr/error.hpp"
+#include "gdsr/geometry/correspondence.hpp"
+#include "gdsr/geometry/wrinkles.hpp"
+#include "tests/support/data_fixtures.hpp"
+#include "tests/support/grid_garment.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <vector>
+
+using gdsr::Points3;
+
+namespace {
+
+// A closed, outward-oriented box [x0,x1] x [y0,y1] x [z0,z1]: 8 vertices, 12 triangles.
+gdsr::TriMesh box(double x0, double x1, double y0, double y1, double z0, double z1) {
+  gdsr::TriMesh m;
+  m.V.resize(8, 3);
+  for (int i = 0; i < 8; ++i) m.V.row(i) << (i & 1 ? x1 : x0), (i & 2 ? y1 : y0), (i & 4 ? z1 : z0);
+  m.F.resize(12, 3);
+  m.F << 0, 2, 1, 1, 2, 3,  // z0 (normal -z)
+      4, 5, 6, 5, 7, 6,     // z1 (+z)
+      0, 1, 4, 1, 5, 4,     // y0 (-y)
+      2, 6, 3, 3, 6, 7,     // y1 (+y)
+      0, 4, 2, 2, 4, 6,     // x0 (-x)
+      1, 3, 5, 3, 7, 5;     // x1 (+x)
+  return m;
+}
+
+// LR 4x4 and HR 8x8 quads over 0.3 m x 0.3 m, every frame stretched by 1.1 along x, HR 2 mm
+// above LR; a box body whose top rises to z = top[t].
+gdsr::Dataset stretched_dataset(const std::vector<double>& top) {
+  gdsr::Dataset d;
+  d.lr = gdsr_test::grid_garment(gdsr_test::GridSpec(4, 4, 0.3, 0.3));
+  d.hr = gdsr_test::grid_garment(gdsr_test::GridSpec(8, 8, 0.3, 0.3));
+  for (double z : top) {
+    Points3 lr = d.lr.V, hr = d.hr.V;
+    lr.col(0) *= 1.1;
+    hr.col(0) *= 1.1;
+    hr.col(2).array() += 0.002;
+    d.lr_frames.push_back(lr);
+    d.hr_frames.push_back(hr);
+    const gdsr::TriMesh b = box(0.1, 0.2, 0.1, 0.2, -0.05, z);
+    d.body_frames.push_back(b.V);
+    d.body_faces = b.F;
+  }
+  d.corr = gdsr::compute_correspondence(d.lr, d.hr);
+  d.raster = gdsr::rasterize_uv(d.hr.UV, d.hr.FUV, 64, 64, 2);
+  d.manifest.garment = "stretched";
+  gdsr::update_manifest_counts(d);
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("gdsr: validity figures of a stretched, lifted sheet over a rising box are the closed-form ones") {
+  // Box top per frame; LR vertex (0.165, 0.15, 0) is inside with depth = top, HR's (at z =
+  // 2 mm) with depth top - 2 mm; no vertex is nearer a side of the box than to its top.
+  const std::vector<double> top = {0.001, 0.004, 0.008, 0.003};
+  const gdsr::Dataset d = stretched_dataset(top);
+  gdsr::ValidityOptions opt;
+  opt.penetration_limit = 0.0035;
+  const gdsr::ValidityFigures v = gdsr::measure_validity(d, opt);
+  CHECK(v.frames == 4);
+  for (const gdsr::ResolutionValidity* r : {&v.lr, &v.hr}) {
+    CHECK(r->si_frames == 4);
+    CHECK(r->si_clean_frames == 4);
+    CHECK(r->si_clean_fraction() == 1.0);
+    CHECK(r->si_max_pairs == 0);
+    CHECK(r->strain.E_u == doctest::Approx(0.01).epsilon(1e-9));
+    CHECK(std::abs(r->strain.E_v) < 1e-15);
+    CHECK(std::abs(r->strain.E_uv) < 1e-15);
+    CHECK(std::abs(r->mean_curvature) < 1e-12);
+  }
+  CHECK(v.strain_ratio_u() == doctest::Approx(1.0));
+  CHECK(std::isnan(v.strain_ratio_v()));  // LR has none: no ratio
+  CHECK(v.agreement_mean == doctest::Approx(0.002).epsilon(1e-9));
+  CHECK(v.agreement_max == doctest::Approx(0.002).epsilon(1e-9));
+  CHECK(v.agreement_rest < 1e-12);
+  REQUIRE(v.body_measured);
+  CHECK(v.lr.max_penetration == doctest::Approx(0.008).epsilon(1e-9));
+  CHECK(v.lr.max_penetration_frame == 2);
+  CHECK(v.lr.frames_over_limit == 2);  // 4 mm and 8 mm
+  CHECK(v.hr.max_penetration == doctest::Approx(0.006).epsilon(1e-9));
+  CHECK(v.hr.max_penetration_frame == 2);
+  CHECK(v.hr.frames_over_limit == 1);  // 6 mm (2 mm, 1 mm and none in the others)
+
+  // Without the body: no penetration figures, and the table says so.
+  opt.body = false;
+  const gdsr::ValidityFigures nb = gdsr::measure_validity(d, opt);
+  CHECK_FALSE(nb.body_measured);
+  CHECK(nb.lr.max_penetration == 0);
+  CHECK(gdsr::validity_table(nb).find("not measured") != std::string::npos);
+  CHECK(gdsr::validity_table(v).find("not measured") == std::string::npos);
+  CHECK(gdsr::validity_table(v).find("max penetration") != std::string::npos);
+}
+
+TEST_CASE("gdsr: validity counts the HR frames that overlap themselves, on every k-th frame") {
+  gdsr::Dataset d = gdsr_test::wave_dataset(4);
+  // Frame 2: the HR sheet wrapped 1.25 times round a cylinder, so a quarter lies on itself.
+  d.hr_frames[2] = gdsr_test::grid_garment(gdsr_test::GridSpec(8, 8, 0.3, 0.3).bent(2.5 * M_PI)).V;
+  const gdsr::ValidityFigures v = gdsr::measure_validity(d);
+  CHECK(v.lr.si_frames == 4);
+  CHECK(v.lr.si_clean_frames == 4);
+  CHECK(v.hr.si_frames == 4);
+  CHECK(v.hr.si_clean_frames == 3);
+  CHECK(v.hr.si_clean_fraction() == doctest::Approx(0.75));
+  CHECK(v.hr.si_max_frame == 2);
+  CHECK(v.hr.si_max_pairs >= 8);  // the second wrap crosses the first in each of the 8 rows of quads
+  CHECK(v.hr.si_median_pairs == 0);
+  CHECK_FALSE(v.body_measured);
+  gdsr::ValidityOptions opt;
+  opt.intersection_stride = 2;  // frames 0 and 2
+  const gdsr::ValidityFigures s2 = gdsr::measure_validity(d, opt);
+  CHECK(s2.hr.si_frames == 2);
+  CHECK(s2.hr.si_clean_frames == 1);
+  CHECK(s2.hr.si_median_pairs == doctest::Approx(0.5 * v.hr.si_max_pairs));
+  opt.intersection_stride = 3;  // frames 0 and 3 miss it
+  CHECK(gdsr::measure_validity(d, opt).hr.si_clean_frames == 2);
+  opt.intersection_stride = 0;
+  CHECK_THROWS_AS(gdsr::measure_validity(d, opt), gdsr::Error);
+}
+
+TEST_CASE("gdsr: validity wrinkles: HR ripples above LR upsampled; figures survive the manifest") {
+  const gdsr::Dataset d = gdsr_test::wave_dataset(5);
+  const gdsr::ValidityFigures v = gdsr::measure_validity(d);
+  double up = 0;
+  for (const auto& X : d.lr_frames) up += gdsr::wrinkle_measure(gdsr::upsample(d.corr, X), d.hr.F).mean_curvature / 5;
+  CHECK(v.upsampled_mean_curvature == doctest::Approx(up).epsilon(1e-12));
+  CHECK(v.hr.mean_curvature > 1.5 * v.upsampled_mean_curvature);
+  CHECK(v.agreement_mean > 0.001);  // the 4 mm HR ripples
+
+  gdsr::Dataset w = d;
+  w.manifest.validity = gdsr::validity_to_json(v);
+  gdsr_test::TempDir dir("validity");
+  gdsr::write_dataset(dir / "ds", w);
+  const gdsr::Dataset back = gdsr::load_dataset(dir / "ds");
+  const gdsr::ValidityFigures r = gdsr::validity_from_json(back.manifest.validity);
+  CHECK(gdsr::validity_to_json(r) == gdsr::validity_to_json(v));
+  CHECK(r.hr.si_frames == 5);
+  CHECK(r.agreement_mean == v.agreement_mean);
+  // A dataset written without figures (as before this field existed) loads with none.
+  gdsr::write_dataset(dir / "old", d);
+  CHECK(gdsr::load_dataset(dir / "old").manifest.validity.empty());
+  nlohmann::json broken = w.manifest.validity;
+  broken["hr"].erase("strain");
+  CHECK_THROWS_WITH_AS(gdsr::validity_from_json(broken), doctest::Contains("hr.strain"), gdsr::Error);
+}

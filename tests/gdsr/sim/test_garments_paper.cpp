@@ -1,0 +1,232 @@
+// The paper's five training garments (tshirt, pants, skirt_pleated, dress_layered,
+// skirt_tiered) on the skeleton body of CMU 01_01 (and one salsa body), at 30 mm and 10 mm:
+// they mesh, scale ~9x, weld every seam one-to-one, keep one UV outline, sit outside the
+// body (Embree signed distance), have no self-intersecting triangles (CGAL, an independent
+// yardstick) and start (nearly) unstrained; layer ids only on the multi-layer garments.
+#include <doctest/doctest.h>
+
+#include "tests/support/cloth_bodies.hpp"
+#include "gdsr/body/body.hpp"
+#include "gdsr/body/body_query.hpp"
+#include "gdsr/geometry/strain.hpp"
+#include "gdsr/sim/garments.hpp"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Surface_mesh.h>
+
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+using gdsr::Vec2;
+using gdsr::Vec3;
+
+namespace {
+
+const char* kNew[] = {"tshirt", "pants", "skirt_pleated", "dress_layered", "skirt_tiered"};
+
+// Number of intersecting triangle pairs (CGAL; pairs sharing a vertex or an edge count only
+// when they truly overlap). -1 when the faces do not form an oriented 2-manifold.
+int self_intersections(const gdsr::Points3& V, const gdsr::Faces& F) {
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  using Mesh = CGAL::Surface_mesh<K::Point_3>;
+  Mesh m;
+  std::vector<Mesh::Vertex_index> vi;
+  for (int v = 0; v < V.rows(); ++v) vi.push_back(m.add_vertex(K::Point_3(V(v, 0), V(v, 1), V(v, 2))));
+  for (int f = 0; f < F.rows(); ++f)
+    if (m.add_face(vi[F(f, 0)], vi[F(f, 1)], vi[F(f, 2)]) == Mesh::null_face()) return -1;
+  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
+  CGAL::Polygon_mesh_processing::self_intersections(m, std::back_inserter(pairs));
+  return static_cast<int>(pairs.size());
+}
+
+const gdsr::TriMesh* body_0101() {
+  static const std::string bvh = "/usr/share/assimp/models/BVH/01_01.bvh";
+  static const gdsr::TriMesh body = std::ifstream(bvh).good() ? gdsr::load_body_rest(bvh) : gdsr::TriMesh{};
+  return body.V.rows() > 0 ? &body : nullptr;
+}
+
+// UV area per pattern panel.
+std::vector<double> panel_areas(const sim::PatternMesh& pm, int panels) {
+  std::vector<double> a(panels, 0.0);
+  const auto& m = pm.mesh;
+  for (int f = 0; f < m.FUV.rows(); ++f) {
+    const Vec2 p0 = m.UV.row(m.FUV(f, 0)), p1 = m.UV.row(m.FUV(f, 1)), p2 = m.UV.row(m.FUV(f, 2));
+    a[pm.uv_panel[m.FUV(f, 0)]] += 0.5 * ((p1 - p0).x() * (p2 - p0).y() - (p1 - p0).y() * (p2 - p0).x());
+  }
+  return a;
+}
+
+// UV vertices of panel `panel` lying on its outline edge `edge` (closed segment).
+std::vector<int> uv_on_edge(const sim::PatternMesh& pm, const sim::Pattern& p, int panel, int edge) {
+  const auto& o = p.panels[panel].outline;
+  const Vec2 a = o[edge], b = o[(edge + 1) % o.size()];
+  std::vector<int> out;
+  for (int u = 0; u < pm.mesh.UV.rows(); ++u) {
+    if (pm.uv_panel[u] != panel) continue;
+    const Vec2 q = pm.mesh.UV.row(u);
+    const double t = std::clamp((q - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+    if ((a + t * (b - a) - q).norm() < 1e-9) out.push_back(u);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("garments: the paper's five garments mesh at 30 and 10 mm, weld seams one-to-one, share UV outlines") {
+  const gdsr::TriMesh* body = body_0101();
+  if (!body) {
+    MESSAGE("skipped: CMU 01_01 BVH not installed");
+    return;
+  }
+  const auto lm = sim::measure_body(*body);
+  for (const std::string name : kNew) {
+    CAPTURE(name);
+    const sim::Pattern pat = sim::garment_pattern(name, lm);
+    const auto lr = sim::mesh_pattern(pat, 0.03);
+    const auto hr = sim::mesh_pattern(pat, 0.01);
+    const double ratio = static_cast<double>(hr.mesh.V.rows()) / lr.mesh.V.rows();
+    CAPTURE(lr.mesh.V.rows());
+    CAPTURE(hr.mesh.V.rows());
+    CHECK(ratio > 7.0);  // ~9x from (30/10)^2
+    CHECK(ratio < 10.5);
+    // One UV outline: every panel has the same area at both resolutions, and every pattern
+    // corner is a UV vertex of both.
+    const int np = static_cast<int>(pat.panels.size());
+    const auto al = panel_areas(lr, np), ah = panel_areas(hr, np);
+    for (int i = 0; i < np; ++i) {
+      CHECK(al[i] > 0);
+      CHECK(al[i] == doctest::Approx(ah[i]).epsilon(1e-9));
+      for (const Vec2& c : pat.panels[i].outline)
+        for (const auto* pm : {&lr, &hr}) {
+          double best = 1e9;
+          for (int u = 0; u < pm->mesh.UV.rows(); ++u)
+            if (pm->uv_panel[u] == i) best = std::min(best, (Vec2(pm->mesh.UV.row(u)) - c).norm());
+          CHECK(best < 1e-12);
+        }
+    }
+    // Seams weld one-to-one: both edges carry the same number of UV vertices and map onto
+    // the same set of welded vertices, each exactly once.
+    for (const auto* pm : {&lr, &hr}) {
+      for (const auto& s : pat.seams) {
+        const auto ua = uv_on_edge(*pm, pat, s.a_panel, s.a_edge);
+        const auto ub = uv_on_edge(*pm, pat, s.b_panel, s.b_edge);
+        REQUIRE(ua.size() >= 2);
+        CHECK(ua.size() == ub.size());
+        std::set<int> va, vb;
+        for (int u : ua) va.insert(pm->mesh.uv_to_vertex[u]);
+        for (int u : ub) vb.insert(pm->mesh.uv_to_vertex[u]);
+        CHECK(va.size() == ua.size());
+        CHECK(va == vb);
+      }
+    }
+  }
+}
+
+TEST_CASE("garments: the paper's five garments rest outside the body, unstrained and free of self-intersections") {
+  const gdsr::TriMesh* body = body_0101();
+  if (!body) {
+    MESSAGE("skipped: CMU 01_01 BVH not installed");
+    return;
+  }
+  const gdsr::BodyQuery query(*body);
+  for (const std::string name : kNew)
+    for (const double pd : {0.03, 0.01}) {
+      CAPTURE(name);
+      CAPTURE(pd);
+      const auto g = sim::make_garment(name, pd, *body);
+      const auto& m = g.mesh;
+      REQUIRE(m.V.allFinite());
+      // Outside the body: no vertex more than 3 mm inside (Embree signed distance).
+      const auto cp = query.closest(m.V);
+      CHECK(cp.sdist.minCoeff() > -0.003);
+      // No two triangles intersect (CGAL); -1 would mean a non-manifold or misoriented mesh.
+      CHECK(self_intersections(m.V, m.F) == 0);
+      // Rest strain against the flat pattern: developable pieces are isometric; the t-shirt's
+      // shoulder fold shears (E_uv) and the pants' crotch blend stretches (E_v) locally.
+      const auto se = gdsr::strain_energies(m, m.V);
+      CAPTURE(se.E_u);
+      CAPTURE(se.E_v);
+      CAPTURE(se.E_uv);
+      const bool cones = name != "tshirt" && name != "pants";
+      CHECK(se.E_u < 0.005);
+      CHECK(se.E_v < (name == "pants" ? 0.12 : 0.005));
+      CHECK(se.E_uv < (cones ? 0.005 : 0.07));
+      // Layers exactly where the garment has them.
+      const int layers = name == "dress_layered" ? 2 : name == "skirt_tiered" ? 3 : 1;
+      CHECK(m.num_layers() == layers);
+      CHECK(m.layer.empty() == (layers == 1));
+      if (layers > 1) {
+        std::set<int> ids(m.layer.begin(), m.layer.end());
+        CHECK(static_cast<int>(ids.size()) == layers);
+        CHECK(*ids.begin() == 0);
+      }
+      // Everything but the t-shirt (which hangs on the shoulders) is pinned at a waistband or top band.
+      CHECK(g.pinned.empty() == (name == "tshirt"));
+      // Outward normals: area-weighted normals point away from the nearest body point.
+      double out = 0, total = 0;
+      for (int f = 0; f < m.F.rows(); ++f) {
+        const Vec3 a = m.V.row(m.F(f, 0)), b = m.V.row(m.F(f, 1)), c = m.V.row(m.F(f, 2));
+        const Vec3 n = (b - a).cross(c - a);
+        const int v = m.F(f, 0);
+        out += n.dot((Vec3(m.V.row(v)) - Vec3(cp.point.row(v))).normalized());
+        total += n.norm();
+      }
+      CHECK(out > 0.5 * total);
+    }
+}
+
+TEST_CASE("garments: the t-shirt sleeves follow the arms, and the t-shirt needs a rest pose with raised arms") {
+  const gdsr::TriMesh* body = body_0101();
+  if (!body) {
+    MESSAGE("skipped: CMU 01_01 BVH not installed");
+    return;
+  }
+  const auto lm = sim::measure_body(*body);
+  for (int k = 0; k < 2; ++k) {
+    REQUIRE(lm.arm_found[k]);
+    CHECK(lm.arm_dir[k].x() * (k == 0 ? 1 : -1) > 0.9);  // 01_01 rests in a T-pose
+    CHECK(lm.arm_len[k] > 0.45);                         // shoulder to wrist, metres
+    CHECK(lm.arm_r[k] > 0.03);
+    CHECK(lm.arm_r[k] < 0.1);
+  }
+  CHECK(lm.ankle_y > 0.03);
+  CHECK(lm.ankle_y < 0.2);
+  const auto g = sim::make_garment("tshirt", 0.03, *body);
+  // Some vertex reaches within 3 cm of each wrist (the cuffs), none beyond it.
+  for (int k = 0; k < 2; ++k) {
+    const Vec3 wrist = lm.arm_root[k] + lm.arm_len[k] * lm.arm_dir[k];
+    double best = 1e9, reach = -1e9;
+    for (int v = 0; v < g.mesh.V.rows(); ++v) {
+      const Vec3 x = g.mesh.V.row(v);
+      reach = std::max(reach, (x - lm.arm_root[k]).dot(lm.arm_dir[k]));
+      best = std::min(best, (x - wrist).norm());
+    }
+    CHECK(best < 0.1);
+    CHECK(reach < lm.arm_len[k] + 1e-6);
+  }
+  // A body without raised arms (the test mannequin has no arms at all): a clear error.
+  CHECK_THROWS_WITH_AS(sim::make_garment("tshirt", 0.03, sim::make_mannequin(1.7)), doctest::Contains("arms"),
+                       std::runtime_error);
+}
+
+TEST_CASE("garments: the paper's garments also fit a salsa dancer's rest pose") {
+  const std::string bvh = std::string(GDSR_SHARED_DIR) + "/motions/cmu-salsa/60_02.bvh";
+  if (!std::ifstream(bvh).good()) {
+    MESSAGE("skipped: " << bvh << " not found");
+    return;
+  }
+  const auto body = gdsr::load_body_rest(bvh);
+  const gdsr::BodyQuery query(body);
+  for (const std::string name : kNew) {
+    CAPTURE(name);
+    const auto g = sim::make_garment(name, 0.03, body);
+    CHECK(query.closest(g.mesh.V).sdist.minCoeff() > -0.005);
+    CHECK(self_intersections(g.mesh.V, g.mesh.F) == 0);
+  }
+}

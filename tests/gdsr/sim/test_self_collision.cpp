@@ -1,0 +1,143 @@
+// Cloth self-collision, judged by an independent yardstick: CGAL's
+// Polygon_mesh_processing::self_intersections (gdsr/geometry/self_intersections.hpp) on the simulated
+// triangle mesh, never the solver's own collision code.
+#include <doctest/doctest.h>
+
+#include "tests/support/cloth_bodies.hpp"
+#include "gdsr/sim/cloth_self_collision.hpp"
+#include "gdsr/sim/cloth_solver.hpp"
+#include "gdsr/sim/garments.hpp"
+#include "gdsr/sim/pattern.hpp"
+#include "gdsr/geometry/self_intersections.hpp"
+
+#include <cmath>
+#include <fstream>
+
+using gdsr::Points3;
+using gdsr::Vec2;
+using gdsr::Vec3;
+
+namespace {
+
+// Horizontal square sheet (side m) at height y centred over x = z = 0 at particle distance h.
+gdsr::GarmentMesh sheet(double side, double h, double y) {
+  sim::Pattern p;
+  p.panels.push_back({"square", {Vec2(0, 0), Vec2(side, 0), Vec2(side, side), Vec2(0, side)}});
+  auto pm = sim::mesh_pattern(p, h);
+  sim::place_pattern(pm, [&](int, const Vec2& uv) { return Vec3(uv.x() - side / 2, y, side / 2 - uv.y()); });
+  return pm.mesh;
+}
+
+// Two meshes as one garment (UV of b shifted so the pattern pieces do not overlap).
+gdsr::GarmentMesh merge(const gdsr::GarmentMesh& a, const gdsr::GarmentMesh& b) {
+  gdsr::GarmentMesh m;
+  const int nv = static_cast<int>(a.V.rows()), nuv = static_cast<int>(a.UV.rows());
+  m.V.resize(nv + b.V.rows(), 3);
+  m.V << a.V, b.V;
+  m.UV.resize(nuv + b.UV.rows(), 2);
+  m.UV << a.UV, (b.UV.rowwise() + Eigen::RowVector2d(10, 0));
+  m.F.resize(a.F.rows() + b.F.rows(), 3);
+  m.F << a.F, (b.F.array() + nv).matrix();
+  m.FUV.resize(a.FUV.rows() + b.FUV.rows(), 3);
+  m.FUV << a.FUV, (b.FUV.array() + nuv).matrix();
+  m.uv_to_vertex = a.uv_to_vertex;
+  for (int u : b.uv_to_vertex) m.uv_to_vertex.push_back(u + nv);
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("self-collision: the CGAL yardstick counts crossing triangles and ignores neighbours") {
+  auto a = sheet(0.2, 0.05, 0.0);
+  CHECK((gdsr::self_intersections(a.V, a.F).pairs == 0));
+  // A second sheet standing vertically through the first one crosses it.
+  auto b = sheet(0.2, 0.05, 0.0);
+  for (int v = 0; v < b.V.rows(); ++v) b.V.row(v) = Vec3(b.V(v, 0) + 0.013, b.V(v, 2) + 0.011, 0.007).transpose();
+  const auto m = merge(a, b);
+  CHECK(!(gdsr::self_intersections(m.V, m.F).pairs == 0));
+}
+
+TEST_CASE("self-collision: the detector flags crossing triangles as tangled") {
+  auto a = sheet(0.2, 0.05, 0.0);
+  auto b = sheet(0.2, 0.05, 0.0);
+  for (int v = 0; v < b.V.rows(); ++v) b.V.row(v) = Vec3(b.V(v, 0) + 0.013, b.V(v, 2) + 0.011, 0.007).transpose();
+  const auto m = merge(a, b);
+  sim::SelfCollision sc(m.F, static_cast<int>(m.V.rows()));
+  sc.detect(m.V, Points3::Zero(m.V.rows(), 3), 0.0, 0.003);
+  CHECK(sc.num_intersecting_pairs() > 0);
+  CHECK(sc.num_tangled_vertices() > 0);
+  // The flat sheet alone: nothing crosses, and nothing non-adjacent is within 3 mm.
+  sim::SelfCollision s1(a.F, static_cast<int>(a.V.rows()));
+  s1.detect(a.V, Points3::Zero(a.V.rows(), 3), 0.0, 0.003);
+  CHECK(s1.num_intersecting_pairs() == 0);
+  CHECK(s1.num_vertex_triangle() == 0);
+}
+
+TEST_CASE("self-collision: a sheet dropped onto a clamped sheet lands on it at both resolutions") {
+  for (double h : {0.03, 0.015}) {
+    CAPTURE(h);
+    // Lower sheet clamped along its border (no body: pinned vertices are fixed); the upper
+    // sheet, smaller and turned, falls from 0.3 m and hits it at ~2.4 m/s.
+    auto lower = sheet(0.5, h, 0.0);
+    auto upper = sheet(0.36, h, 0.3);
+    const double c = std::cos(0.5), s = std::sin(0.5);
+    for (int v = 0; v < upper.V.rows(); ++v) {
+      const double x = upper.V(v, 0), z = upper.V(v, 2);
+      upper.V(v, 0) = c * x - s * z;
+      upper.V(v, 2) = s * x + c * z;
+    }
+    sim::Garment g;
+    g.name = "two sheets";
+    g.particle_distance = h;
+    g.mesh = merge(lower, upper);
+    const int nl = static_cast<int>(lower.V.rows());
+    for (int v = 0; v < nl; ++v)
+      if (std::max(std::abs(lower.V(v, 0)), std::abs(lower.V(v, 2))) > 0.25 - 1e-9) g.pinned.push_back(v);
+    sim::SimParams p;
+    p.settle_frames = 0;
+    sim::ClothSolver solver(g, gdsr::Faces(), Points3(), p);
+    int bad_frames = 0, below = 0;
+    for (int t = 0; t < 24; ++t) {
+      solver.step(Points3(), Points3(), 1.0 / 30);
+      const auto& X = solver.positions();
+      if (gdsr::self_intersections(X, g.mesh.F).pairs > 0) ++bad_frames;
+    }
+    // Every upper vertex above the lower sheet stays above it (the sheet sags only a little).
+    const auto& X = solver.positions();
+    double lower_max = -1e9;
+    for (int v = 0; v < nl; ++v) lower_max = std::max(lower_max, X(v, 1));
+    for (int v = nl; v < X.rows(); ++v)
+      if (std::max(std::abs(X(v, 0)), std::abs(X(v, 2))) < 0.2 && X(v, 1) < lower_max - 0.05) ++below;
+    CAPTURE(bad_frames);
+    CAPTURE(below);
+    CHECK(bad_frames == 0);
+    CHECK(below == 0);
+  }
+}
+
+TEST_CASE("self-collision: a cloth draped over a sphere folds without self-intersection") {
+  const double r = 0.15;
+  auto sphere = sim::make_sphere(Vec3(0, 0, 0), r, 24, 48);
+  for (double h : {0.03, 0.015}) {
+    CAPTURE(h);
+    sim::Garment g;
+    g.mesh = sheet(0.6, h, r + 0.02);
+    g.name = "square";
+    g.particle_distance = h;
+    sim::SimParams p;
+    p.settle_frames = 0;
+    std::vector<Points3> frames(45, sphere.V);
+    const auto out = sim::simulate_frames(g, sphere.F, frames, 30.0, p);
+    int bad_frames = 0, worst = 0;
+    for (size_t t = 0; t < out.size(); t += 2) {
+      const int n = static_cast<int>(gdsr::self_intersections(out[t], g.mesh.F).pairs);
+      bad_frames += n > 0;
+      worst = std::max(worst, n);
+    }
+    CAPTURE(bad_frames);
+    CAPTURE(worst);
+    CHECK(bad_frames == 0);
+    // It did fold: the rim hangs well below the top.
+    CHECK(out.back().col(1).minCoeff() < -0.05);
+  }
+}

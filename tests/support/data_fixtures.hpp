@@ -1,0 +1,54 @@
+// Small garment meshes and temp folders for the data tests (header only, test code).
+#pragma once
+
+#include "gdsr/data/dataset.hpp"
+#include "gdsr/geometry/correspondence.hpp"
+#include "gdsr/geometry/mesh.hpp"
+#include "tests/support/grid_garment.hpp"
+#include "gdsr/geometry/uv_raster.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+
+namespace gdsr_test {
+
+// A fresh empty folder under the system temp dir, removed on destruction.
+struct TempDir {
+  std::filesystem::path path;
+  explicit TempDir(const std::string& name) {
+    path = std::filesystem::temp_directory_path() / ("gdsr_test_" + name + "_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(path);
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+  std::string operator/(const std::string& name) const { return (path / name).string(); }
+};
+
+// A 4x4-quad LR sheet and an 8x8-quad HR sheet of the same UV outline (0.3 m square),
+// waving over `frames` frames, the HR one with finer ripples; no body.
+inline gdsr::Dataset wave_dataset(int frames = 8) {
+  gdsr::Dataset d;
+  d.lr = gdsr_test::grid_garment(gdsr_test::GridSpec(4, 4, 0.3, 0.3));
+  d.hr = gdsr_test::grid_garment(gdsr_test::GridSpec(8, 8, 0.3, 0.3));
+  for (int t = 0; t < frames; ++t) {
+    const double ph = 0.4 * t;
+    gdsr::Points3 lr = d.lr.V, hr = d.hr.V;
+    for (int i = 0; i < lr.rows(); ++i) lr(i, 2) = 0.03 * std::sin(10 * lr(i, 0) + ph);
+    for (int i = 0; i < hr.rows(); ++i)
+      hr(i, 2) = 0.03 * std::sin(10 * hr(i, 0) + ph) + 0.004 * std::sin(60 * hr(i, 1) + 2 * ph);
+    d.lr_frames.push_back(lr);
+    d.hr_frames.push_back(hr);
+  }
+  d.corr = gdsr::compute_correspondence(d.lr, d.hr);
+  d.raster = gdsr::rasterize_uv(d.hr.UV, d.hr.FUV, 96, 96, 2);
+  d.manifest.garment = "wave";
+  gdsr::update_manifest_counts(d);
+  return d;
+}
+
+}  // namespace gdsr_test

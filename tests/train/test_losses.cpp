@@ -1,0 +1,221 @@
+#include <doctest/doctest.h>
+
+#include "autograd/autograd.hpp"
+#include "train/losses.hpp"
+#include "tests/support/loss_test_meshes.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+using namespace gdsr;
+
+namespace {
+
+bool finite(const std::vector<double>& v) {
+  for (double x : v)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+
+LossConfig only(const std::string& term) {
+  LossConfig c;
+  for (LossTerm* t : {&c.c_position, &c.c_normal, &c.c_strain, &c.c_smooth, &c.c_dihedral, &c.f_position,
+                      &c.f_normal_map, &c.f_strain, &c.f_smooth})
+    t->on = false;
+  if (term == "c_position") c.c_position.on = true;
+  if (term == "c_normal") c.c_normal.on = true;
+  if (term == "c_strain") c.c_strain.on = true;
+  if (term == "c_smooth") c.c_smooth.on = true;
+  if (term == "c_dihedral") c.c_dihedral.on = true;
+  if (term == "f_position") c.f_position.on = true;
+  if (term == "f_vgg") c.f_normal_map.on = true, c.f_image_l1.on = false;
+  if (term == "f_image_l1") c.f_normal_map.on = true, c.f_vgg.on = false;
+  if (term == "f_strain") c.f_strain.on = true;
+  if (term == "f_smooth") c.f_smooth.on = true;
+  return c;
+}
+
+ag::Tensord rows_of(const Points3& P, const std::vector<int>& rows) {
+  Points3 R(static_cast<int>(rows.size()), 3);
+  for (size_t i = 0; i < rows.size(); ++i) R.row(static_cast<int>(i)) = P.row(rows[i]);
+  return to_tensor<double>(R);
+}
+
+}  // namespace
+
+TEST_CASE("losses: config defaults follow the reference, JSON round trip, unknown keys throw") {
+  const LossConfig d;
+  CHECK(d.c_position.weight == 1.0);
+  CHECK(d.c_normal.weight == 0.01);
+  CHECK(d.c_strain.weight == 0.01);
+  CHECK(d.c_smooth.weight == 100.0);
+  CHECK(d.c_dihedral.weight == 0.003);
+  CHECK(d.f_normal_map.weight == 0.01);
+  CHECK(d.f_strain.weight == 0.01);
+  CHECK(d.f_smooth.weight == 0.05);
+  LossConfig c;
+  c.c_dihedral = {false, 0.5};
+  c.f_vgg.weight = 2;
+  c.image_l1_garment_only = true;
+  c.lambda_every_epochs = 3;
+  const LossConfig r = loss_config_from_json(loss_config_to_json(c));
+  CHECK(r.c_dihedral.on == false);
+  CHECK(r.c_dihedral.weight == 0.5);
+  CHECK(r.f_vgg.weight == 2);
+  CHECK(r.image_l1_garment_only);
+  CHECK(r.lambda_every_epochs == 3);
+  CHECK(loss_config_to_json(r) == loss_config_to_json(c));
+  CHECK_THROWS(loss_config_from_json(nlohmann::json::parse(R"({"coarse": {"positon": {"on": true}}})")));
+  CHECK_THROWS(loss_config_from_json(nlohmann::json::parse(R"({"coarse": {"normal": {"weight": -1}}})")));
+  CHECK_THROWS(loss_config_from_json(nlohmann::json::parse(R"({"fine": {"smooth": {"on": 3.5}}})")));
+  const LossConfig p = loss_config_from_json(nlohmann::json::parse(R"({"fine": {"vgg": {"on": false}}})"));
+  CHECK(!p.f_vgg.on);
+  CHECK(p.c_smooth.weight == 100.0);
+
+  const std::string path = std::string(GDSR_BINARY_DIR) + "/test_loss_config.json";
+  {
+    std::ofstream o(path);
+    o << R"({"schedule": {"on": false}})";
+  }
+  CHECK(!load_loss_config(path).schedule);
+  std::remove(path.c_str());
+  CHECK_THROWS(load_loss_config(path));
+}
+
+TEST_CASE("losses: lambda schedule moves by 0.2 every 10 epochs until both are 1") {
+  const LossConfig c;
+  const double expect_c[] = {1.9, 1.7, 1.5, 1.3, 1.1, 1.0, 1.0};
+  for (int k = 0; k < 7; ++k) {
+    for (int e : {10 * k, 10 * k + 9}) {
+      CAPTURE(e);
+      const Lambdas l = lambda_schedule(c, e);
+      CHECK(l.coarse == doctest::Approx(expect_c[k]));
+      CHECK(l.fine == doctest::Approx(std::min(1.0, 0.1 + 0.2 * k)));
+    }
+  }
+  CHECK(lambda_schedule(c, 300).coarse == 1.0);
+  CHECK(lambda_schedule(c, 300).fine == 1.0);
+  LossConfig off;
+  off.schedule = false;
+  CHECK(lambda_schedule(off, 0).coarse == 1.0);
+  CHECK(lambda_schedule(off, 0).fine == 1.0);
+  const ag::Tensord t = total_loss(Lambdas{1.9, 0.1}, ag::Tensord::scalar(2.0), ag::Tensord::scalar(3.0));
+  CHECK(t.item() == doctest::Approx(1.9 * 2 + 0.1 * 3));
+}
+
+TEST_CASE("losses: coarse terms vanish at the ground truth and pass float64 gradient checks") {
+  const GarmentMesh g0 = gdsr_test::grid_garment(gdsr_test::GridSpec::spaced(5, 0.03));
+  for (double scale : {1.0, 1e-3, 1e3}) {
+    CAPTURE(scale);
+    GarmentMesh g = g0;
+    g.V *= scale;
+    g.UV *= scale;
+    const MeshTopology t = make_topology(g);
+    // x1e3: also moved to x ~ +1000 (uniform gradcheck step, see test_geometry_ad).
+    const double offset = scale > 1 ? 1000.0 : 0.0;
+    const Points3 gt = gdsr_test::bumpy(g0.V, 0.4, scale, 1).array() + offset;
+    const Points3 pred = gdsr_test::bumpy(g0.V, 0.3, scale, 2).array() + offset;
+
+    const CoarseLoss<double> same = coarse_loss(LossConfig{}, t, to_tensor<double>(gt), gt);
+    CHECK(same.position == 0.0);
+    CHECK(same.normal == 0.0);
+    CHECK(same.strain == 0.0);
+    CHECK(same.dihedral == 0.0);
+    CHECK(same.smooth > 0.0);
+    CHECK(same.total.item() == doctest::Approx(100.0 * same.smooth));
+
+    const CoarseLoss<double> all = coarse_loss(LossConfig{}, t, to_tensor<double>(pred), gt);
+    CHECK(all.position > 0);
+    CHECK(all.normal > 0);
+    CHECK(all.strain > 0);
+    CHECK(all.dihedral > 0);
+    CHECK(all.total.item() == doctest::Approx(all.position + 0.01 * all.normal + 0.01 * all.strain + 100 * all.smooth +
+                                              0.003 * all.dihedral));
+    const CoarseLoss<float> allf = coarse_loss(LossConfig{}, t, to_tensor<float>(pred), gt);
+    CHECK(allf.total.item() == doctest::Approx(all.total.item()).epsilon(1e-4));
+
+    for (const char* term : {"c_position", "c_normal", "c_strain", "c_smooth", "c_dihedral"}) {
+      INFO(term);
+      const LossConfig cfg = only(term);
+      ag::GradCheckOptions opt;
+      opt.step = scale <= 1 ? 1e-6 * scale : 1e-7;  // h ~ 1e-6 of the mesh size (see test_geometry_ad)
+      const ag::GradCheckResult r =
+          ag::gradcheck([&](const std::vector<ag::Tensord>& in) { return coarse_loss(cfg, t, in[0], gt).total; },
+                        {to_tensor<double>(pred)}, opt);
+      INFO(r.report());
+      CHECK(r.max_rel_error < 1e-6);
+    }
+  }
+}
+
+TEST_CASE("losses: coarse loss is finite with zero-area triangles") {
+  const GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec::spaced(4, 0.05));
+  const MeshTopology t = make_topology(g);
+  const Points3 gt = gdsr_test::bumpy(g.V, 0.2, 1.0, 1);
+  Points3 pred = gdsr_test::bumpy(g.V, 0.2, 1.0, 2);
+  pred.row(g.F(0, 1)) = pred.row(g.F(0, 0));  // face 0 collapses to a segment, then a point
+  pred.row(g.F(0, 2)) = pred.row(g.F(0, 0));
+  ag::Tensord x = to_tensor<double>(pred);
+  x.set_requires_grad(true);
+  const CoarseLoss<double> l = coarse_loss(LossConfig{}, t, x, gt);
+  CHECK(std::isfinite(l.total.item()));
+  l.total.backward();
+  REQUIRE(x.has_grad());
+  CHECK(finite(x.grad()));
+}
+
+TEST_CASE("losses: fine loss over a patch batch, with an image-loss callback, float64 gradient check") {
+  const GarmentMesh g = gdsr_test::cut_garment(21, 0.01);
+  PatchConfig pc;
+  pc.size = 24;
+  pc.count = 3;
+  std::vector<int> lr(g.V.rows(), 0);
+  const PatchSampler s(rasterize_uv(g.UV, g.FUV, 128, 128, 4), g, lr, pc);
+  std::mt19937_64 rng(11);
+  const PatchBatch b = s.sample(rng);
+  REQUIRE(b.patches.size() == 3);
+  const Points3 gt = gdsr_test::bumpy(g.V, 0.3, 1.0, 1);
+  const Points3 pred = gdsr_test::bumpy(g.V, 0.25, 1.0, 2);
+
+  int calls = 0;
+  const ImageLossFn<double> mse = [&](const ag::Tensord& a, const ag::Tensord& bb) {
+    ++calls;
+    CHECK(a.shape() == ag::Shape{3, 3, 24, 24});
+    CHECK(bb.shape() == a.shape());
+    return ag::mse_loss(ag::reshape(a, {3, 3 * 24 * 24}), ag::reshape(bb, {3, 3 * 24 * 24}));
+  };
+  const FineLoss<double> same = fine_loss(LossConfig{}, b, rows_of(gt, b.vertices), gt, mse);
+  CHECK(calls == 1);
+  CHECK(same.position == 0.0);
+  CHECK(same.image_l1 == 0.0);
+  CHECK(same.vgg == 0.0);
+  CHECK(same.strain == 0.0);
+  CHECK(same.smooth > 0.0);
+  const FineLoss<double> all = fine_loss(LossConfig{}, b, rows_of(pred, b.vertices), gt, mse);
+  CHECK(all.position > 0);
+  CHECK(all.image_l1 > 0);
+  CHECK(all.vgg > 0);
+  CHECK(all.strain > 0);
+  CHECK(all.total.item() ==
+        doctest::Approx(all.position + 0.01 * (all.vgg + all.image_l1) + 0.01 * all.strain + 0.05 * all.smooth));
+  LossConfig masked;
+  masked.image_l1_garment_only = true;
+  const FineLoss<double> m = fine_loss(masked, b, rows_of(pred, b.vertices), gt, mse);
+  CHECK(m.image_l1 > all.image_l1);  // same differences, fewer pixels in the mean
+  // No callback: the VGG term is skipped.
+  CHECK(fine_loss(LossConfig{}, b, rows_of(pred, b.vertices), gt).vgg == 0.0);
+
+  for (const char* term : {"f_position", "f_vgg", "f_image_l1", "f_strain", "f_smooth"}) {
+    CAPTURE(term);
+    const LossConfig cfg = only(term);
+    const ag::GradCheckResult r =
+        ag::gradcheck([&](const std::vector<ag::Tensord>& in) { return fine_loss(cfg, b, in[0], gt, mse).total; },
+                      {rows_of(pred, b.vertices)});
+    INFO(r.report());
+    CHECK(r.max_rel_error < 1e-6);
+  }
+  const FineLoss<float> f = fine_loss<float>(LossConfig{}, b, to_tensor<float>(rows_of(pred, b.vertices).mat()), gt);
+  CHECK(f.total.item() ==
+        doctest::Approx(fine_loss(LossConfig{}, b, rows_of(pred, b.vertices), gt).total.item()).epsilon(1e-4));
+}

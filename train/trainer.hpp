@@ -1,0 +1,63 @@
+// Training GDSR on one or more datasets (paper 4.5): one frame per step, teacher forcing
+// (the history C^_{t-1}, C^_{t-2} is the downsampled HR ground truth), coarse loss on the
+// corrected LR garment and the patch-based fine loss on the HR vertices under a batch of UV
+// patches (A is evaluated only on the LR triangles those patches need). AdamW with the
+// reference settings, lr step decay, the lambda schedule, periodic atomic checkpoints.
+// A non-finite loss or gradient stops training with an exception before the parameters
+// are touched, so the last checkpoint on disk is the last good one.
+#pragma once
+
+#include "gdsr/data/dataset.hpp"
+#include "train/losses.hpp"
+#include "gdsr/model/model_config.hpp"
+#include "train/patches.hpp"
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace gdsr {
+
+struct TrainOptions {
+  ModelConfig model;
+  LossConfig loss;
+  PatchConfig patches;
+  int epochs = 1;          // passes over all training frames (t >= 2) of all datasets
+  int64_t max_steps = -1;  // stop earlier after this many steps (< 0: no limit)
+  double lr = 1e-4;        // AdamW, reference settings
+  double weight_decay = 0.01;
+  bool amsgrad = true;
+  int64_t lr_halve_every = 50000;  // steps
+  double lr_floor = 1e-6;
+  bool fine = true;        // patches + hyper-net A (false: coarse correction only)
+  bool vgg = true;         // VGG feature term of the fine loss
+  std::string vgg_dir;     // empty: ../shared/weights/vgg19-imagenet-conv1-conv3
+  uint64_t seed = 1;       // frame order, patches, noise
+  std::string checkpoint;  // written every checkpoint_every steps and at the end ("" = never)
+  int64_t checkpoint_every = 100;
+  std::string resume;  // continue from this checkpoint (model + optimizer + step)
+};
+
+struct TrainLog {
+  int64_t step = 0, total_steps = 0;
+  int epoch = 0;
+  double loss = 0, coarse = 0, fine = 0;  // total and the two weighted parts
+  double lambda_c = 1, lambda_w = 1, lr = 0;
+  double seconds = 0;                   // wall time of this step
+  std::map<std::string, double> terms;  // unweighted loss terms
+};
+
+struct TrainResult {
+  int64_t steps = 0;
+  double first_loss = 0, last_loss = 0;              // single-step totals
+  double first_epoch_mean = 0, last_epoch_mean = 0;  // mean total over the first / last epoch
+  double seconds_per_step = 0;
+  int64_t parameters = 0;
+  std::string checkpoint;
+};
+
+TrainResult train_gdsr(const std::vector<const Dataset*>& data, const TrainOptions& opt,
+                       const std::function<void(const TrainLog&)>& log = {});
+
+}  // namespace gdsr
