@@ -40,6 +40,10 @@ struct MakeArgs {
   double start = 0.0;                 // clip start, seconds
   double fps = 30;
   int substeps = -1;  // <0: the solver's default
+  // Solver knobs (NaN / <0: the solver's default, sim::SimParams).
+  int iterations = -1;
+  double friction = NAN, bend_stiffness = NAN, self_thickness = NAN;
+  bool self_collision = true;
   int rest_blend_frames = 15;
   int raster = 1024;
   int intersection_stride = kDefaultIntersectionStride;
@@ -121,6 +125,11 @@ void run_make(const MakeArgs& a) {
 
   sim::SimParams params;
   if (a.substeps > 0) params.substeps = a.substeps;
+  if (a.iterations > 0) params.iterations = a.iterations;
+  if (!std::isnan(a.friction)) params.friction = a.friction;
+  if (!std::isnan(a.bend_stiffness)) params.bend_stiffness = a.bend_stiffness;
+  if (!std::isnan(a.self_thickness)) params.self_thickness = a.self_thickness;
+  params.self_collision = a.self_collision;
   const SimRun lr = simulate_one(a, a.lr_pd, "LR", body, params);
   const SimRun hr = simulate_one(a, a.hr_pd, "HR", body, params);
 
@@ -153,6 +162,8 @@ void run_make(const MakeArgs& a) {
                   {"bend_stiffness_n_m", params.bend_stiffness},
                   {"damping_1_s", params.damping},
                   {"settle_frames", params.settle_frames},
+                  {"self_collision", params.self_collision},
+                  {"self_thickness_m", params.self_thickness},
                   {"clip_start_s", a.start},
                   {"clip_seconds", a.seconds}};
   gdsr::update_manifest_counts(d);
@@ -366,6 +377,15 @@ void add_data_command(CLI::App& app) {
   make->add_option("--start", mk->start, "clip start in seconds")->capture_default_str();
   make->add_option("--fps", mk->fps, "frames per second")->capture_default_str();
   make->add_option("--substeps", mk->substeps, "solver substeps per frame (default: the solver's)");
+  make->add_option("--iterations", mk->iterations, "constraint passes per substep (default: the solver's)")
+      ->check(CLI::Range(1, 100));
+  make->add_option("--friction", mk->friction, "Coulomb friction against the body (default: the solver's)")
+      ->check(CLI::Range(0.0, 2.0));
+  make->add_option("--bend-stiffness", mk->bend_stiffness, "bending modulus, N m (default: the solver's)")
+      ->check(CLI::Range(0.0, 1.0));
+  make->add_option("--self-thickness", mk->self_thickness, "cloth-cloth distance kept, metres (default: the solver's)")
+      ->check(CLI::Range(0.0, 0.05));
+  make->add_flag("!--no-self-collision", mk->self_collision, "switch cloth self-collision off");
   make->add_option("--rest-blend", mk->rest_blend_frames, "frames blending from the rest pose")->capture_default_str();
   make->add_option("--raster", mk->raster, "UV raster size in pixels")->capture_default_str();
   make->add_option("--intersection-stride", mk->intersection_stride, "count self-intersections on every k-th frame")

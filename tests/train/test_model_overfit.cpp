@@ -31,7 +31,8 @@ struct Adam {
   Adam(std::vector<ag::Tensorf> p, double lr_) : params(std::move(p)), lr(lr_) {
     for (auto& x : params) m.emplace_back(x.numel(), 0.f), v.emplace_back(x.numel(), 0.f);
   }
-  void step() {
+  void step(double lr_now) {
+    lr = lr_now;
     ++t;
     const double c1 = 1 - std::pow(b1, t), c2 = 1 - std::pow(b2, t);
     for (size_t k = 0; k < params.size(); ++k) {
@@ -103,7 +104,10 @@ TEST_CASE("model overfit: a small model fits one frame pair (coarse + fine loss 
     if (s == 0) first = v, first_c = c.total.item(), first_f = f.total.item();
     last = v, last_c = c.total.item(), last_f = f.total.item();
     total.backward();
-    opt.step();
+    // Linear decay to 10%: at a constant rate Adam keeps oscillating near the minimum, and the
+    // last loss then depends on float32 rounding (Eigen's SIMD sums change with the heap
+    // alignment of the buffers: measured 4.7e-4 to 1.9e-3 for the fine term at 2e-3).
+    opt.step(2e-3 * (1.0 - 0.9 * s / steps));
   }
   MESSAGE("loss " << first << " -> " << last << " (coarse " << first_c << " -> " << last_c << ", fine " << first_f
                   << " -> " << last_f << ") in " << steps << " Adam steps; " << batch.vertices.size()
