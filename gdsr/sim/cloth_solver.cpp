@@ -150,6 +150,19 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     grid_.build(bodyF_, body_V0, body_V0, cell);
     place_pins(body_V0);
   }
+  if (p.implicit_bending && !bends_.empty()) {
+    std::vector<BendStencil> stencils;
+    stencils.reserve(bends_.size());
+    for (const Bend& b : bends_)
+      stencils.push_back({{b.v[0], b.v[1], b.v[2], b.v[3]}, {b.K[0], b.K[1], b.K[2], b.K[3]}, 1.0 / b.compliance});
+    std::vector<char> fixed(nv);
+    for (int v = 0; v < nv; ++v) fixed[v] = winv_[v] == 0;
+    implicit_bending_ = std::make_unique<ImplicitBending>(nv, stencils, mass_, fixed);
+  }
+  if (!g.pinned.empty() && p.tethers) {
+    if (!(p.tether_stretch >= 0)) gdsr::fail("sim/cloth_solver", "tether_stretch must be >= 0");
+    tethers_ = make_tethers(m, g.pinned);
+  }
   body_cell_ = cell;
   xprev_ = x_;
   if (p.self_collision) {
@@ -373,11 +386,13 @@ void ClothSolver::step(const Points3& body_from, const Points3& body_to, double 
     detect_self_contacts(h);
     predict(h, decay);
     if (has_body) place_pins(body_now);
+    if (implicit_bending_) implicit_bending_->solve(h, x_);
     std::fill(lambda_e.begin(), lambda_e.end(), 0.0);
     std::fill(lambda_b.begin(), lambda_b.end(), 0.0);
     for (int it = 0; it < p_.iterations; ++it) {
       solve_edges(lambda_e, h2);
-      solve_bends(lambda_b, h2);
+      project_tethers(tethers_, p_.tether_stretch, x_);
+      if (!implicit_bending_) solve_bends(lambda_b, h2);
       solve_layers();
       solve_body_contacts(body_prev, body_now);
       solve_self_contacts();

@@ -1,9 +1,11 @@
 // XPBD cloth solver (substeps with a few constraint passes each). Constraints:
 // edge lengths from the flat pattern (stretch + shear against the UV rest shape), isometric
-// bending (Bergou et al. 2006, flat rest state), body contact with thickness and Coulomb
+// bending (Bergou et al. 2006, flat rest state; by default solved implicitly, see
+// sim/cloth_bending_solve.hpp), body contact with thickness and Coulomb
 // friction against the moving body (closest body triangle, refreshed every few substeps,
 // body velocity from the frame blend), pinned vertices bound to the nearest body triangle,
-// inner/outer layer contact for multi-layer garments, and cloth self-contact (see
+// inner/outer layer contact for multi-layer garments, long-range attachments to the pins
+// (sim/cloth_tethers.hpp), and cloth self-contact (see
 // sim/cloth_self_collision.hpp). Without a body, pinned vertices stay fixed in space. Sequential Gauss-Seidel in a
 // fixed order: the same inputs give bit-identical output. Units: metres, seconds, kg.
 // The body is Y-up (gravity along -y by default).
@@ -12,8 +14,10 @@
 #include "gdsr/body/body.hpp"
 #include "gdsr/geometry/mesh.hpp"
 #include "gdsr/io/progress.hpp"
+#include "gdsr/sim/cloth_bending_solve.hpp"
 #include "gdsr/sim/cloth_collision.hpp"
 #include "gdsr/sim/cloth_self_collision.hpp"
+#include "gdsr/sim/cloth_tethers.hpp"
 #include "gdsr/sim/garments.hpp"
 
 #include <functional>
@@ -44,6 +48,9 @@ struct SimParams {
   int self_detect_every = 4;      // substeps between self-contact detections (sooner when a vertex leaves its slack)
   double self_slack = 0.003;      // m, how far a vertex may leave its predicted path before re-detection
   int self_passes = 1;            // self-contact Gauss-Seidel passes per iteration (stops early when none is violated)
+  bool implicit_bending = true;   // bending by one linear solve per substep (sim/cloth_bending_solve.hpp)
+  bool tethers = true;            // long-range attachments to the pins (sim/cloth_tethers.hpp)
+  double tether_stretch = 0.002;  // stretch a tether allows beyond the rest distance along the cloth (0.2%)
 };
 
 // Stateful solver for one garment on one body topology.
@@ -60,6 +67,7 @@ class ClothSolver {
   const std::vector<double>& masses() const { return mass_; }  // kg per vertex (pinned too)
   int num_edges() const { return static_cast<int>(edges_.size()); }
   int num_bends() const { return static_cast<int>(bends_.size()); }
+  int num_tethers() const { return static_cast<int>(tethers_.size()); }
   // Self-contact pairs and tangled vertices at the last detection (0 without self-collision).
   int num_self_pairs() const { return self_ ? self_->num_vertex_triangle() + self_->num_edge_edge() : 0; }
   int num_tangled_vertices() const { return self_ ? self_->num_tangled_vertices() : 0; }
@@ -110,6 +118,8 @@ class ClothSolver {
   std::vector<Edge> edges_;
   std::vector<Bend> bends_;
   std::vector<Pin> pins_;
+  std::vector<Tether> tethers_;
+  std::unique_ptr<ImplicitBending> implicit_bending_;
   std::vector<Contact> contacts_;
   std::vector<LayerPair> layer_pairs_;
   SurfaceGrid grid_;
