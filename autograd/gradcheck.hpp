@@ -19,7 +19,9 @@ struct GradCheckResult {
 
 struct GradCheckOptions {
   // Relative step: h = step * scale with scale = the largest |x| over that input (1 if it is
-  // all zero), so the check behaves the same on inputs of size 1e-20 and 1e20.
+  // all zero), so the check behaves the same on inputs of size 1e-20 and 1e20. (A step
+  // relative to each entry instead raises round-off on small entries; inputs whose columns
+  // differ much in size are best checked one at a time, each with its own step.)
   // The difference quotient divides by the step actually taken, (x + h) - (x - h) in floating
   // point, not by the nominal 2h.
   double step = 1e-6;
