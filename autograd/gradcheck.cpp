@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <sstream>
@@ -23,7 +24,7 @@ GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>
                           const GradCheckOptions& opt) {
   std::mt19937_64 rng(opt.seed);
   for (auto& x : inputs) {
-    if (x.node().backward_fn) throw Error("gradcheck: inputs must be leaves");
+    if (x.node().backward_fn || x.node().freed) throw Error("gradcheck: inputs must be leaves");
     x.zero_grad();
     x.set_requires_grad(true);
   }
@@ -47,6 +48,8 @@ GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>
     for (size_t i = 0; i < w.size(); ++i) s += w[i] * y.data()[i];
     return s;
   };
+  double loss_magnitude = 0;  // sum |w f|: the size round-off in L is relative to
+  for (size_t i = 0; i < w.size(); ++i) loss_magnitude += std::abs(w[i] * probe.data()[i]);
 
   // Analytic gradients.
   {
@@ -67,21 +70,27 @@ GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>
     }
     const std::vector<double> analytic = x.has_grad() ? x.grad() : std::vector<double>(static_cast<size_t>(n), 0.0);
 
+    double scale = 0;  // the input's size: steps and the floor are relative to it
+    for (double v : x.values()) scale = std::max(scale, std::abs(v));
+    if (!(scale > 0) || !std::isfinite(scale)) scale = 1;
+
     std::vector<double> numeric(entries.size());
     for (size_t e = 0; e < entries.size(); ++e) {
       double& v = x.values()[static_cast<size_t>(entries[e])];
       const double orig = v;
-      const double h = opt.step * std::max(1.0, std::abs(orig));
-      v = orig + h;
+      const double h = opt.step * scale;
+      const double xp = orig + h, xm = orig - h;
+      v = xp;
       const double lp = loss_value();
-      v = orig - h;
+      v = xm;
       const double lm = loss_value();
       v = orig;
-      numeric[e] = (lp - lm) / (2 * h);
+      numeric[e] = (lp - lm) / (xp - xm);
     }
     double largest = 0;
     for (double v : numeric) largest = std::max(largest, std::abs(v));
-    const double floor = std::max(opt.floor_fraction * largest, opt.abs_floor) + 1e-12;
+    const double floor = std::max({opt.floor_fraction * largest, opt.abs_floor, 1e-12 * loss_magnitude / scale,
+                                   std::numeric_limits<double>::min()});
     for (size_t e = 0; e < entries.size(); ++e) {
       const double a = analytic[static_cast<size_t>(entries[e])], nu = numeric[e];
       double rel = std::abs(a - nu) / std::max({std::abs(a), std::abs(nu), floor});

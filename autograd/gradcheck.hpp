@@ -18,10 +18,18 @@ struct GradCheckResult {
 };
 
 struct GradCheckOptions {
-  double step = 1e-6;  // relative step: h = step * max(1, |x|)
-  // Entries are compared as |a - n| / max(|a|, |n|, floor), floor = floor_fraction *
-  // (largest |n| over the input) + 1e-12: entries far below the largest gradient of their
-  // input are judged against it, so round-off on tiny gradients does not dominate.
+  // Relative step: h = step * scale with scale = the largest |x| over that input (1 if it is
+  // all zero), so the check behaves the same on inputs of size 1e-20 and 1e20. (A step
+  // relative to each entry instead raises round-off on small entries; inputs whose columns
+  // differ much in size are best checked one at a time, each with its own step.)
+  // The difference quotient divides by the step actually taken, (x + h) - (x - h) in floating
+  // point, not by the nominal 2h.
+  double step = 1e-6;
+  // Entries are compared as |a - n| / max(|a|, |n|, floor), floor = max(floor_fraction *
+  // (largest |n| over the input), abs_floor, 1e-12 * |L| / scale) with |L| = sum |w f|: entries
+  // far below the largest gradient of their input are judged against it, so round-off on tiny
+  // gradients does not dominate; the last term is relative to the loss and input scale (a
+  // fixed absolute floor would pass any gradient of inputs of size 1e-20).
   double floor_fraction = 1e-3;
   // A lower bound for that floor. Central differences of a loss L carry round-off of about
   // 1e-16 |L| / step; where L sums many outputs, gradients near that level are noise, and

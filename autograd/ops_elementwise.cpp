@@ -1,5 +1,6 @@
 #include "autograd/ops_elementwise.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace ag {
@@ -222,18 +223,21 @@ template <class T> Tensor<T> clamp(const Tensor<T>& x, T lo, T hi) {
 }
 
 // atan2(y, x): d/dy = x / r^2, d/dx = -y / r^2, r^2 = x^2 + y^2; both 0 at the origin.
+// Formed as (x / m) / (r / m)^2 / m with m = max(|x|, |y|), as hypot does, so that r^2 neither
+// overflows nor underflows: exact wherever 1 / r is a finite float.
+namespace {
+template <class T> T atan2_partial(T num, T y, T x) {
+  const T m = std::max(std::abs(x), std::abs(y));
+  if (!(m > T(0))) return T(0);
+  const T xs = x / m, ys = y / m;
+  return num / m / (xs * xs + ys * ys) / m;
+}
+}  // namespace
 template <class T> Tensor<T> atan2(const Tensor<T>& y, const Tensor<T>& x) {
   check_same_shape("atan2", y.shape(), x.shape());
   return binary_op<T>(
-      "atan2", y, x, [](T a, T b) { return std::atan2(a, b); },
-      [](T a, T b, T) {
-        const T r2 = a * a + b * b;
-        return r2 > T(0) ? b / r2 : T(0);
-      },
-      [](T a, T b, T) {
-        const T r2 = a * a + b * b;
-        return r2 > T(0) ? -a / r2 : T(0);
-      });
+      "atan2", y, x, [](T a, T b) { return std::atan2(a, b); }, [](T a, T b, T) { return atan2_partial(b, a, b); },
+      [](T a, T b, T) { return atan2_partial(-a, a, b); });
 }
 
 #define AG_ANY(T)                                             \

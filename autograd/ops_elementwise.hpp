@@ -27,20 +27,27 @@ template <class T> Tensor<T> operator-(const Tensor<T>& a, T s) { return add_sca
 template <class T> Tensor<T> operator*(const Tensor<T>& a, T s) { return mul_scalar(a, s); }
 template <class T> Tensor<T> operator*(T s, const Tensor<T>& a) { return mul_scalar(a, s); }
 
-// Real scalar types only (float, double).
+// Real scalar types only (float, double). Valid input ranges follow IEEE arithmetic; where a
+// value or gradient leaves the float range it becomes inf or NaN (never clamped silently):
+// exp overflows above ~88.7 (float32) / ~709.8 (float64).
 template <class T> Tensor<T> exp(const Tensor<T>& x);
+// Needs x > 0: log(0) = -inf with gradient +inf, log(x < 0) = NaN.
 template <class T> Tensor<T> log(const Tensor<T>& x);
-template <class T> Tensor<T> sqrt(const Tensor<T>& x);  // gradient at 0 is +inf; add an eps first
+// Needs x >= 0 (NaN below). At exactly 0 the gradient is +inf, and a zero upstream gradient
+// (a masked entry) then gives 0 * inf = NaN: add an eps first where x can reach 0.
+template <class T> Tensor<T> sqrt(const Tensor<T>& x);
 template <class T> Tensor<T> sin(const Tensor<T>& x);
 template <class T> Tensor<T> cos(const Tensor<T>& x);
 template <class T> Tensor<T> tanh(const Tensor<T>& x);
 template <class T> Tensor<T> abs(const Tensor<T>& x);  // d|x|/dx at 0 taken as 0
 template <class T> Tensor<T> square(const Tensor<T>& x);
-template <class T> Tensor<T> pow(const Tensor<T>& x, T p);  // x^p; for non-integer p needs x > 0
+template <class T> Tensor<T> pow(const Tensor<T>& x, T p);  // x^p; for non-integer p needs x > 0 (NaN below)
 template <class T> Tensor<T> relu(const Tensor<T>& x);
 template <class T> Tensor<T> leaky_relu(const Tensor<T>& x, T slope);
 template <class T> Tensor<T> sigmoid(const Tensor<T>& x);
 template <class T> Tensor<T> clamp(const Tensor<T>& x, T lo, T hi);          // gradient 0 outside [lo, hi]
-template <class T> Tensor<T> atan2(const Tensor<T>& y, const Tensor<T>& x);  // same shapes; grad at (0,0) taken as 0
+// Same shapes; grad at (0,0) taken as 0. Valid for all finite y, x: the gradient is scaled
+// first (as hypot), exact down to subnormal and up to near-overflow magnitudes.
+template <class T> Tensor<T> atan2(const Tensor<T>& y, const Tensor<T>& x);
 
 }  // namespace ag

@@ -77,7 +77,11 @@ template <class T> void linear_backward(Node<T>& xn, Node<T>& wn, Node<T>* bn, c
   }
   if (bn && bn->requires_grad) {
     bn->ensure_grad();
-    Eigen::Map<Eigen::Matrix<T, 1, Eigen::Dynamic>>(bn->grad.data(), O) += G.colwise().sum();
+    // Plain loop in row order: an Eigen reduction's summation order can depend on the
+    // data's alignment, i.e. on the heap, making runs differ in the last bits.
+    T* gb = bn->grad.data();
+    for (int64_t r = 0; r < N; ++r)
+      for (int64_t o = 0; o < O; ++o) gb[o] += g[r * O + o];
   }
 }
 // Y += X W^T in row blocks (Y is a fresh, zeroed output).

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <string>
 
 namespace ag {
 
@@ -77,17 +79,32 @@ template <class T> Tensor<T> cross3(const Tensor<T>& a, const Tensor<T>& b) {
 
 // ---- norm_rows ----------------------------------------------------------------------------------------
 namespace {
-// |row| without overflow/underflow of the squares for very large or small entries.
-template <class T> T row_norm(const T* x, int64_t C) {
+// A row scaled by a power of two near its largest magnitude (exact), so that its squares
+// neither overflow nor underflow: |x| = scale * len, x / |x| = x_j * inv_scale / len.
+template <class T> struct ScaledRow {
+  T scale = 1, inv_scale = 1, len = 0;  // len = |x / scale|, 0 for the zero row
+  T norm() const { return scale * len; }
+};
+template <class T> ScaledRow<T> scaled_row(const T* x, int64_t C) {
   T m = 0;
   for (int64_t j = 0; j < C; ++j) m = std::max(m, std::abs(x[j]));
-  if (m == 0 || !std::isfinite(m)) return m;
+  ScaledRow<T> r;
+  if (m == 0) return r;
+  if (!std::isfinite(m)) {  // inf or NaN entries: plain arithmetic propagates them
+    r.len = m;
+    return r;
+  }
+  // clamped so that 1 / scale is finite for subnormal rows
+  const int e = std::max(std::ilogb(m), std::numeric_limits<T>::min_exponent - 1);
+  r.scale = std::ldexp(T(1), std::min(e, std::numeric_limits<T>::max_exponent - 2));
+  r.inv_scale = T(1) / r.scale;
   T s = 0;
   for (int64_t j = 0; j < C; ++j) {
-    const T v = x[j] / m;
+    const T v = x[j] * r.inv_scale;
     s += v * v;
   }
-  return m * std::sqrt(s);
+  r.len = std::sqrt(s);
+  return r;
 }
 }  // namespace
 
@@ -98,19 +115,20 @@ template <class T> Tensor<T> norm_rows(const Tensor<T>& x) {
   const T* px = x.data();
   T* o = out.data();
 #pragma omp parallel for if (R * C > kParallelMin)
-  for (int64_t r = 0; r < R; ++r) o[r] = row_norm(px + r * C, C);
+  for (int64_t r = 0; r < R; ++r) o[r] = scaled_row(px + r * C, C).norm();
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), R, C] {
     if (!xn->requires_grad) return;
     xn->ensure_grad();
     const T* g = on->grad.data();
-    const T* n = on->value.data();
     const T* px = xn->value.data();
     T* gx = xn->grad.data();
 #pragma omp parallel for if (R * C > kParallelMin)
     for (int64_t r = 0; r < R; ++r) {
-      if (n[r] == 0) continue;  // subgradient 0 at the zero vector
-      const T s = g[r] / n[r];
-      for (int64_t j = 0; j < C; ++j) gx[r * C + j] += s * px[r * C + j];
+      const ScaledRow<T> sr = scaled_row(px + r * C, C);
+      if (sr.len == 0) continue;  // subgradient 0 at the zero vector
+      // d|x|/dx = x / |x| = (x / scale) / len: every factor <= 1, finite for subnormal and huge rows
+      const T il = T(1) / sr.len;
+      for (int64_t j = 0; j < C; ++j) gx[r * C + j] += g[r] * (px[r * C + j] * sr.inv_scale * il);
     }
   });
   return out;
@@ -119,18 +137,24 @@ template <class T> Tensor<T> norm_rows(const Tensor<T>& x) {
 // ---- normalize_rows --------------------------------------------------------------------------------------
 template <class T> Tensor<T> normalize_rows(const Tensor<T>& x, T eps) {
   check_2d("normalize_rows", x.shape());
+  if (!(eps > T(0)) || !std::isfinite(eps))
+    throw Error("normalize_rows: eps must be finite and > 0 (it keeps zero rows finite), got " + std::to_string(eps));
   const int64_t R = x.rows(), C = x.cols();
   auto out = new_output<T>({R, C});
-  std::vector<T> nrm(static_cast<size_t>(R));
+  std::vector<ScaledRow<T>> rows(static_cast<size_t>(R));
   const T* px = x.data();
   T* o = out.data();
 #pragma omp parallel for if (R * C > kParallelMin)
   for (int64_t r = 0; r < R; ++r) {
-    nrm[r] = row_norm(px + r * C, C);
-    const T d = std::max(nrm[r], eps);
-    for (int64_t j = 0; j < C; ++j) o[r * C + j] = px[r * C + j] / d;
+    const ScaledRow<T> sr = rows[r] = scaled_row(px + r * C, C);
+    if (sr.len > 0 && sr.norm() > eps) {  // x / |x| from the scaled row: finite at any magnitude
+      const T il = T(1) / sr.len;
+      for (int64_t j = 0; j < C; ++j) o[r * C + j] = px[r * C + j] * sr.inv_scale * il;
+    } else {
+      for (int64_t j = 0; j < C; ++j) o[r * C + j] = px[r * C + j] / eps;
+    }
   }
-  record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), nrm = std::move(nrm), eps, R, C] {
+  record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), rows = std::move(rows), eps, R, C] {
     if (!xn->requires_grad) return;
     xn->ensure_grad();
     const T* g = on->grad.data();
@@ -140,11 +164,12 @@ template <class T> Tensor<T> normalize_rows(const Tensor<T>& x, T eps) {
     for (int64_t r = 0; r < R; ++r) {
       const T* gr = g + r * C;
       T* gxr = gx + r * C;
-      if (nrm[r] > eps) {  // y = x/|x|: dx = (g - y (y.g)) / |x|
+      const ScaledRow<T>& sr = rows[r];
+      if (sr.len > 0 && sr.norm() > eps) {  // y = x/|x|: dx = (g - y (y.g)) / |x|
         const T* yr = y + r * C;
         T yg = 0;
         for (int64_t j = 0; j < C; ++j) yg += yr[j] * gr[j];
-        for (int64_t j = 0; j < C; ++j) gxr[j] += (gr[j] - yr[j] * yg) / nrm[r];
+        for (int64_t j = 0; j < C; ++j) gxr[j] += (gr[j] - yr[j] * yg) * sr.inv_scale / sr.len;
       } else {  // y = x/eps
         for (int64_t j = 0; j < C; ++j) gxr[j] += gr[j] / eps;
       }

@@ -55,6 +55,10 @@ void backward_from(const std::shared_ptr<NodeBase>& root, bool retain_graph) {
     throw Error("backward: needs a one-element tensor, got " + std::to_string(root->numel()) +
                 " elements (reduce with sum or mean first)");
   if (!root->requires_grad) throw Error("backward: the tensor does not require grad");
+  if (root->freed)
+    throw Error(
+        "backward: this graph was already freed by an earlier backward(); pass retain_graph = true to the first "
+        "backward() to run it twice");
 
   // Iterative post-order DFS -> topological order (parents before children).
   std::vector<NodeBase*> order;
@@ -65,6 +69,11 @@ void backward_from(const std::shared_ptr<NodeBase>& root, bool retain_graph) {
     auto& [node, next] = stack.back();
     if (next < node->parents.size()) {
       NodeBase* p = node->parents[next++].get();
+      if (p && p->freed)
+        throw Error(
+            "backward: the graph uses an intermediate tensor whose history an earlier backward() freed, so its "
+            "inputs would get no gradient; use retain_graph = true there, or detach() the tensor to use it as a "
+            "constant");
       if (p && p->requires_grad && seen.insert(p).second) stack.push_back({p, 0});
     } else {
       order.push_back(node);
@@ -87,6 +96,7 @@ void backward_from(const std::shared_ptr<NodeBase>& root, bool retain_graph) {
         n->backward_fn = nullptr;
         n->zero_grad();
         n->parents.clear();
+        n->freed = true;
       }
     }
   }

@@ -67,6 +67,9 @@ struct NodeBase {
   bool requires_grad = false;
   std::vector<std::shared_ptr<NodeBase>> parents;
   std::function<void()> backward_fn;  // reads this node's grad, adds into parents' grads
+  // Set when a backward() without retain_graph released this intermediate's history: a later
+  // backward() that reaches it throws instead of treating it as a leaf.
+  bool freed = false;
   virtual void zero_grad() = 0;
   virtual void seed_grad_one() = 0;  // grad := 1 (scalar root)
   virtual int64_t numel() const = 0;
@@ -86,7 +89,11 @@ template <class T> struct Node final : NodeBase {
 };
 
 // Run reverse mode from `root` (which must hold exactly one element). Leaves keep their
-// gradients; intermediates are released afterwards unless retain_graph is true.
+// gradients; intermediates are released afterwards unless retain_graph is true. Throws
+// ag::Error (and changes nothing) if the graph reaches an intermediate released by an earlier
+// backward(): a second backward() of the same loss, or a new loss built on a released
+// intermediate, would otherwise give its inputs no gradient silently. Keep the graph with
+// retain_graph = true, or detach() the intermediate to use it as a constant.
 void backward_from(const std::shared_ptr<NodeBase>& root, bool retain_graph = false);
 
 // ---- the tensor handle -------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include "autograd/ops_elementwise.hpp"
 #include "autograd/ops_index.hpp"
 #include "autograd/ops_loss.hpp"
+#include "autograd/ops_reduce.hpp"
 #include "autograd/ops_shape.hpp"
 
 #include <algorithm>
@@ -95,7 +96,10 @@ template <class T> CoarseLoss<T> coarse_loss(const LossConfig& cfg, const MeshTo
   }
   if (cfg.c_dihedral.on && !lr.pair_f0.empty()) {
     const ag::Tensor<T> agt = no_grad<T>([&] { return dihedral_angles(gt, lr); });
-    const ag::Tensor<T> l = ag::l1_loss(dihedral_angles(C_hat, lr), agt);
+    // |angle - gt| weighted by |n0| |n1| of the prediction: 1 on healthy pairs (the plain L1),
+    // and a bounded gradient on predicted slivers (see dihedral_terms).
+    const DihedralTerms<T> d = dihedral_terms(C_hat, lr);
+    const ag::Tensor<T> l = ag::mean(ag::mul(d.weight, ag::abs(ag::sub(d.angle, agt))));
     out.dihedral = static_cast<double>(l.item());
     accumulate(total, l, cfg.c_dihedral.weight);
   }

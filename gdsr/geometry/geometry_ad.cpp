@@ -190,12 +190,19 @@ template <class T> ag::Tensor<T> smoothness(const ag::Tensor<T>& X, const MeshTo
   return ag::mul_scalar(ag::sum(ag::square(r)), static_cast<T>(1.0 / count));
 }
 
-template <class T> ag::Tensor<T> dihedral_angles(const ag::Tensor<T>& X, const MeshTopology& t) {
+template <class T> DihedralTerms<T> dihedral_terms(const ag::Tensor<T>& X, const MeshTopology& t) {
   if (t.pair_f0.empty()) gdsr::fail("geometry_ad", "dihedral_angles: mesh has no adjacent face pairs");
   const ag::Tensor<T> n = face_normals(X, t);
   const ag::Tensor<T> n0 = ag::index_select_rows(n, t.pair_f0);
   const ag::Tensor<T> n1 = ag::index_select_rows(n, t.pair_f1);
-  return ag::atan2(ag::norm_rows(ag::cross3(n0, n1)), ag::dot_rows(n0, n1));
+  DihedralTerms<T> d;
+  d.angle = ag::atan2(ag::norm_rows(ag::cross3(n0, n1)), ag::dot_rows(n0, n1));
+  d.weight = ag::mul(ag::norm_rows(n0), ag::norm_rows(n1));
+  return d;
+}
+
+template <class T> ag::Tensor<T> dihedral_angles(const ag::Tensor<T>& X, const MeshTopology& t) {
+  return dihedral_terms(X, t).angle;
 }
 
 template <class T> ag::Tensor<T> to_tensor(const Points3& P) { return ag::Tensor<T>::from_eigen(P.cast<T>()); }
@@ -215,6 +222,7 @@ template <class T> Points3 to_points(const ag::Tensor<T>& X) {
   template ag::Tensor<T> smoothness_residual<T>(const ag::Tensor<T>&, const MeshTopology&);          \
   template ag::Tensor<T> smoothness<T>(const ag::Tensor<T>&, const MeshTopology&, const ag::Index*); \
   template ag::Tensor<T> dihedral_angles<T>(const ag::Tensor<T>&, const MeshTopology&);              \
+  template DihedralTerms<T> dihedral_terms<T>(const ag::Tensor<T>&, const MeshTopology&);            \
   template ag::Tensor<T> to_tensor<T>(const Points3&);                                               \
   template Points3 to_points<T>(const ag::Tensor<T>&);
 

@@ -72,6 +72,15 @@ ag::Tensor<T> smoothness(const ag::Tensor<T>& X, const MeshTopology& t, const ag
 
 // Dihedral angle per adjacent face pair, [P x 1], radians in [0, pi].
 template <class T> ag::Tensor<T> dihedral_angles(const ag::Tensor<T>& X, const MeshTopology& t);
+// The angles and, per pair, weight = |n0| |n1| [P x 1] of the face normals above: 1 (to
+// rounding) for pairs of healthy faces, falling to 0 as either face degenerates (|cross| <
+// normal_eps). The angle's own gradient is 1 / height on a sliver (3e6 at 1e-9 m high);
+// weight * angle has a gradient bounded by ~ edge / normal_eps, so a sliver cannot
+// dominate a dihedral loss.
+template <class T> struct DihedralTerms {
+  ag::Tensor<T> angle, weight;
+};
+template <class T> DihedralTerms<T> dihedral_terms(const ag::Tensor<T>& X, const MeshTopology& t);
 
 // Points3 (N x 3, metres) -> tensor [N x 3] (a leaf without grad) and back.
 template <class T> ag::Tensor<T> to_tensor(const Points3& P);

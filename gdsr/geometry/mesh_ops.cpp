@@ -182,9 +182,15 @@ Frames triangle_frames(const Points3& V, const Faces& F, double eps) {
   Frames out(F.rows(), 9);
   for (int f = 0; f < F.rows(); ++f) {
     const Vec3 v0 = row3(V, F(f, 0)), v1 = row3(V, F(f, 1)), v2 = row3(V, F(f, 2));
-    const Vec3 y = normalized_eps(v2 - v1, eps);
-    const Vec3 z = normalized_eps((v2 - v1).cross(v0 - v1), eps);
-    const Vec3 x = normalized_eps(y.cross(z), eps);
+    const Vec3 a = v2 - v1, b = v0 - v1;
+    const double L2 = a.squaredNorm() + b.squaredNorm();  // the triangle's size, squared
+    if (!(L2 > 0)) {  // collapsed to a point: the zero frame
+      out.row(f).setZero();
+      continue;
+    }
+    const Vec3 y = normalized_eps(a, eps * std::sqrt(L2));
+    const Vec3 z = normalized_eps(a.cross(b), eps * L2);
+    const Vec3 x = y.cross(z);
     out.row(f) << x.transpose(), y.transpose(), z.transpose();
   }
   return out;

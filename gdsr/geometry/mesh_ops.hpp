@@ -53,10 +53,12 @@ std::vector<int> boundary_vertices(const Faces& F);
 double mean_edge_length(const Points3& V, const Faces& F);
 
 // Local frame of each triangle (v0, v1, v2), stored as F x 9 rows (x, y, z) with
-// y = normalize(v2 - v1), z = normalize((v2 - v1) x (v0 - v1)), x = normalize(y x z);
-// normalize(a) = a / max(|a|, eps) with eps = 1e-6 (the reference's convention).
+// y = normalize(v2 - v1, eps L), z = normalize((v2 - v1) x (v0 - v1), eps L^2), x = y x z;
+// normalize(a, e) = a / max(|a|, e), L = sqrt(|v2 - v1|^2 + |v0 - v1|^2). eps is relative to
+// the triangle's own size (the reference's absolute 1e-6 is not scale-free); a triangle
+// collapsed to a point gets the zero frame. The plain-double twin of triangle_frames_ad.
 using Frames = Eigen::Matrix<double, Eigen::Dynamic, 9, Eigen::RowMajor>;
-Frames triangle_frames(const Points3& V, const Faces& F, double eps = 1e-6);
+Frames triangle_frames(const Points3& V, const Faces& F, double eps = 1e-3);
 
 // Dihedral angle per face pair: atan2(|n0 x n1|, n0 . n1) in radians, 0 for a flat pair,
 // up to pi for a folded one. Uses unit face normals (zero normals give angle 0).

@@ -20,15 +20,40 @@ ag::Index face_column(const Faces& F, const ag::Index& faces, int k) {
 }
 }  // namespace
 
+namespace {
+// a / max(|a|, floor) per row, floor [n x 1] differentiable: the two branches of PyTorch's
+// F.normalize with a per-row eps. A row with |a| = floor = 0 (a triangle collapsed to a point)
+// gives 0.
+template <class T> ag::Tensor<T> normalize_rows_floor(const ag::Tensor<T>& a, const ag::Tensor<T>& floor) {
+  const ag::Tensor<T> n = ag::norm_rows(a);
+  const int64_t R = n.rows();
+  std::vector<T> use_norm(static_cast<size_t>(R)), point(static_cast<size_t>(R));
+  for (int64_t r = 0; r < R; ++r) {
+    use_norm[r] = n.data()[r] > floor.data()[r] ? T(1) : T(0);
+    point[r] = n.data()[r] == T(0) && floor.data()[r] == T(0) ? T(1) : T(0);
+  }
+  const ag::Tensor<T> m = ag::Tensor<T>::from({R, 1}, std::move(use_norm));
+  const ag::Tensor<T> d = ag::add(ag::add(ag::mul(m, n), ag::mul(ag::add_scalar(ag::neg(m), T(1)), floor)),
+                                  ag::Tensor<T>::from({R, 1}, std::move(point)));
+  return ag::div(a, d);
+}
+}  // namespace
+
 template <class T>
 ag::Tensor<T> triangle_frames_ad(const ag::Tensor<T>& X, const Faces& F, const ag::Index& faces, T eps) {
+  if (!(eps > T(0))) gdsr::fail("triangle_frames_ad", "eps must be > 0 (a fraction of the triangle's size)");
   const ag::Tensor<T> v0 = ag::index_select_rows(X, face_column(F, faces, 0));
   const ag::Tensor<T> v1 = ag::index_select_rows(X, face_column(F, faces, 1));
   const ag::Tensor<T> v2 = ag::index_select_rows(X, face_column(F, faces, 2));
-  const ag::Tensor<T> a = ag::sub(v2, v1);
-  const ag::Tensor<T> y = ag::normalize_rows(a, eps);
-  const ag::Tensor<T> z = ag::normalize_rows(ag::cross3(a, ag::sub(v0, v1)), eps);
-  const ag::Tensor<T> x = ag::normalize_rows(ag::cross3(y, z), eps);
+  const ag::Tensor<T> a = ag::sub(v2, v1), b = ag::sub(v0, v1);
+  // The triangle's own size L = sqrt(|a|^2 + |b|^2): eps is relative to it (L for y, L^2 for
+  // the normal), so mm and m meshes get the same frames.
+  const ag::Tensor<T> L = ag::norm_rows(ag::concat_cols<T>({a, b}));
+  const ag::Tensor<T> y = normalize_rows_floor(a, ag::mul_scalar(L, eps));
+  const ag::Tensor<T> z = normalize_rows_floor(ag::cross3(a, b), ag::mul_scalar(ag::square(L), eps));
+  // y, z are unit and orthogonal (or shrunk on degenerate faces), so y x z needs no third
+  // normalisation; one fewer 1/eps factor in the gradient of degenerate faces.
+  const ag::Tensor<T> x = ag::cross3(y, z);
   return ag::concat_cols<T>({x, y, z});
 }
 

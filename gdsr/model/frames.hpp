@@ -10,8 +10,13 @@
 namespace gdsr {
 
 // Local frame of the faces `faces` (indices into F) of X: rows (x, y, z) flattened to
-// [n x 9] with y = normalize(v2 - v1), z = normalize((v2 - v1) x (v0 - v1)),
-// x = normalize(y x z); normalize(a) = a / max(|a|, eps) (reference: eps = 1e-6).
+// [n x 9] with y = normalize(v2 - v1, eps L), z = normalize((v2 - v1) x (v0 - v1), eps L^2),
+// x = y x z; normalize(a, e) = a / max(|a|, e), L = sqrt(|v2 - v1|^2 + |v0 - v1|^2) the
+// triangle's own size. eps > 0 is dimensionless (the reference uses an absolute 1e-6, which
+// shrinks the normal of a triangle with 1 mm edges to 0.89): frames are invariant under
+// scaling X, and exact unit frames for every triangle whose shortest-edge / area ratios stay
+// above eps. Degenerate faces (zero area, coincident vertices) get a shrunk frame with a
+// gradient bounded by ~2 / (eps L); a face collapsed to a point gets the zero frame.
 template <class T>
 ag::Tensor<T> triangle_frames_ad(const ag::Tensor<T>& X, const Faces& F, const ag::Index& faces, T eps);
 

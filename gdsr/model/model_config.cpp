@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -43,6 +44,14 @@ void check_widths(const char* name, const std::vector<int64_t>& w) {
   for (int64_t v : w)
     if (v <= 0) gdsr::fail("model_config", std::string(name) + " has a non-positive width");
 }
+// A real-valued key must be finite and satisfy `ok`; the one-line error names the key, the
+// allowed range and the value.
+void require(const char* key, double value, bool ok, const char* range) {
+  if (ok && std::isfinite(value)) return;
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", value);
+  gdsr::fail("model_config", std::string(key) + " must be " + range + ", got " + buf);
+}
 }  // namespace
 
 void ModelConfig::validate() const {
@@ -67,11 +76,17 @@ void ModelConfig::validate() const {
   if (mp_steps < 0) gdsr::fail("model_config", "mp_steps must be >= 0");
   if (field_width <= 0) gdsr::fail("model_config", "field_width must be positive");
   if (field_wire_layers < 1) gdsr::fail("model_config", "field_wire_layers must be >= 1");
-  if (!(wire_s0 >= 0) || !(wire_omega0 >= 0)) gdsr::fail("model_config", "wire_omega0 and wire_s0 must be >= 0");
-  if (!(sigma_b > 0) || !(sigma_l > 0)) gdsr::fail("model_config", "sigma_b and sigma_l must be positive");
-  if (!(noise_std >= 0)) gdsr::fail("model_config", "noise_std must be >= 0");
-  if (!(frame_eps > 0)) gdsr::fail("model_config", "frame_eps must be positive");
-  if (!(a_proj_init_gain > 0)) gdsr::fail("model_config", "a_proj_init_gain must be positive");
+  // The domain of the maths: WIRE's Gaussian envelope needs s0 > 0 (at s0 = 0, |psi| =
+  // e^{-omega0 Im x} overflows float32 at Im x = -20 for omega0 = 5).
+  require("wire_s0", wire_s0, wire_s0 > 0, "> 0");
+  require("wire_omega0", wire_omega0, wire_omega0 >= 0, ">= 0");
+  require("sigma_b", sigma_b, sigma_b > 0, "> 0 (metres)");
+  require("sigma_l", sigma_l, sigma_l > 0, "> 0 (metres)");
+  require("noise_std", noise_std, noise_std >= 0, ">= 0 (metres)");
+  require("frame_eps", frame_eps, frame_eps > 0 && frame_eps < 1, "in (0, 1) (relative to a triangle's size)");
+  require("a_proj_init_gain", a_proj_init_gain, a_proj_init_gain > 0, "> 0");
+  require("e_scale_init", e_scale_init, true, "finite");
+  require("field_scale_init", field_scale_init, true, "finite");
 }
 
 #define GDSR_CONFIG_FIELDS(X)                                                                                       \

@@ -97,3 +97,35 @@ TEST_CASE("core: a small real model is the same in float32 and float64 within 1e
   for (size_t i = 0; i < w1d.grad().size(); ++i) err = std::max(err, std::abs(double(w1f.grad()[i]) - w1d.grad()[i]));
   CHECK(err < 1e-5);
 }
+
+TEST_CASE("core: a second backward through a freed graph throws") {
+  Tensord x = randn({3, 2}, 13).set_requires_grad(true);
+  const Tensord l = sum(ag::tanh(x) * x);
+  l.backward();
+  const std::vector<double> g = x.grad();
+  CHECK_THROWS_WITH_AS(l.backward(), doctest::Contains("retain_graph"), ag::Error);
+  CHECK(x.grad() == g);  // nothing changed by the refused call
+}
+
+TEST_CASE("core: a freed intermediate in a new graph throws instead of acting as a leaf") {
+  Tensord x = randn({3, 2}, 14).set_requires_grad(true);
+  const Tensord h = ag::tanh(x);
+  sum(h * h).backward();
+  const std::vector<double> g = x.grad();
+  const Tensord l2 = sum(h * 3.0);
+  CHECK_THROWS_WITH_AS(l2.backward(), doctest::Contains("detach"), ag::Error);
+  CHECK(x.grad() == g);
+  // detach() makes the intent explicit: h is a constant, x gets only the direct term
+  const Tensord l3 = sum(h.detach() * x);
+  l3.backward();
+  for (size_t i = 0; i < g.size(); ++i) CHECK(x.grad()[i] == doctest::Approx(g[i] + h.values()[i]));
+}
+
+TEST_CASE("core: a retained intermediate reused in a second loss gets its inputs a gradient") {
+  Tensord x = randn({3, 2}, 15).set_requires_grad(true);
+  const Tensord h = x * x;
+  sum(h).backward(true);
+  x.zero_grad();
+  sum(h * 3.0).backward();
+  for (size_t i = 0; i < x.values().size(); ++i) CHECK(x.grad()[i] == doctest::Approx(6 * x.values()[i]));
+}

@@ -98,14 +98,12 @@ TEST_CASE("elementwise: unary values match std") {
 }
 
 TEST_CASE("elementwise: sqrt near 0 (small positive)") {
-  // x in [1e-6, 1e-5]: the default step (1e-6 absolute) would cross 0, so the step is made
-  // 1e-11; truncation error (h/x)^2 < 1e-10, round-off well below the tolerance.
-  ag::GradCheckOptions opt;
-  opt.step = 1e-11;
+  // x in [1e-6, 1e-5]: gradcheck's step is relative to the input's size (h = 1e-6 * max x
+  // ~ 1e-11), so it does not cross 0; truncation error (h/x)^2 < 1e-10.
   check_grad(
-      "sqrt near 0", kTol, [](auto& in) { return ag::sqrt(in[0]); }, {randu({4, 4}, 31, 1e-6, 1e-5)}, opt);
+      "sqrt near 0", kTol, [](auto& in) { return ag::sqrt(in[0]); }, {randu({4, 4}, 31, 1e-6, 1e-5)});
   check_grad(
-      "log near 0", kTol, [](auto& in) { return ag::log(in[0]); }, {randu({4, 4}, 32, 1e-6, 1e-5)}, opt);
+      "log near 0", kTol, [](auto& in) { return ag::log(in[0]); }, {randu({4, 4}, 32, 1e-6, 1e-5)});
 }
 
 TEST_CASE("elementwise: atan2 on random inputs, near 0 and near pi") {
@@ -116,8 +114,9 @@ TEST_CASE("elementwise: atan2 on random inputs, near 0 and near pi") {
              {rand_signed({5, 4}, 43, 1e-8, 1e-6), randu({5, 4}, 44, 0.5, 2.0)});
   // near +-pi: y -> 0 (both signs), x < 0. |y| >= 1e-3 so that y +- h never crosses the
   // branch cut at y = 0 (where the value jumps by 2 pi). Values ~pi carry an absolute
-  // round-off of ~4e-16 while d/dx ~ y/x^2 is ~1e-3: a step of 1e-4 (truncation error
-  // (h/x)^2 ~ 1e-7) keeps that round-off below the 1e-6 tolerance.
+  // round-off of ~4e-16 while d/dx ~ y/x^2 is ~1e-3: a step of 1e-4 of each input's size
+  // (h <= 1e-6 for y, 2e-4 for x, truncation error (h/x)^2 ~ 1e-8) keeps that round-off
+  // below the 1e-6 tolerance.
   ag::GradCheckOptions near_pi;
   near_pi.step = 1e-4;
   check_grad(
@@ -141,7 +140,7 @@ TEST_CASE("elementwise: atan2 on random inputs, near 0 and near pi") {
 TEST_CASE("elementwise: inputs scaled by 1e-3 and 1e3") {
   for (double s : {1e-3, 1e3}) {
     INFO("scale " << s);
-    const ag::GradCheckOptions opt = step_for_scale(s);
+    const ag::GradCheckOptions opt;  // gradcheck's step is relative to the input's size
     const Tensord a = randn({4, 3}, 51, s), b = randn({4, 3}, 52, s);
     check_grad(
         "mul scaled", kTol, [](auto& in) { return in[0] * in[1]; }, {a, b}, opt);
@@ -202,4 +201,34 @@ TEST_CASE("elementwise: float32 matches float64 within 1e-5") {
   const auto d = f(a, b, bp);
   const auto s = f(to_float(a), to_float(b), to_float(bp));
   CHECK(max_abs_diff(s, d) < 1e-5);
+}
+
+TEST_CASE("elementwise: atan2 gradient at subnormal-square and overflow-square magnitudes") {
+  // y = x = a: d/dy = 1 / (2a), d/dx = -1 / (2a). x^2 + y^2 underflows (small a) or
+  // overflows (large a) in the working precision; the scaled form must not.
+  auto check = [](auto a) {
+    using T = decltype(a);
+    ag::Tensor<T> y = ag::Tensor<T>::full({1, 1}, a, true), x = ag::Tensor<T>::full({1, 1}, a, true);
+    const ag::Tensor<T> v = ag::atan2(y, x);
+    CHECK(double(v.item()) == doctest::Approx(M_PI / 4));
+    sum(v).backward();
+    const double want = 0.5 / double(a);
+    CHECK(double(y.grad()[0]) == doctest::Approx(want).epsilon(1e-6));
+    CHECK(double(x.grad()[0]) == doctest::Approx(-want).epsilon(1e-6));
+  };
+  for (float a : {1e-23f, 1e20f, 1e-30f, 3e37f}) {
+    CAPTURE(a);
+    check(a);
+  }
+  for (double a : {1e-170, 1e200, 1e-300, 1e300}) {
+    CAPTURE(a);
+    check(a);
+  }
+  // and a float64 gradient check at those scales (gradcheck's step is relative to them)
+  for (double s : {1e-170, 1e200}) {
+    CAPTURE(s);
+    check_grad(
+        "atan2 extreme", kTol, [](auto& in) { return ag::atan2(in[0], in[1]); },
+        {randn({3, 3}, 61, s), randn({3, 3}, 62, s)});
+  }
 }

@@ -26,3 +26,20 @@ TEST_CASE("gradcheck: a wrong backward is caught") {
                                {ag::Tensord::from({2, 2}, {0.5, -1.0, 2.0, 1.5})});
   CHECK(r.max_rel_error > 0.4);
 }
+
+TEST_CASE("gradcheck: a planted 2x-wrong gradient is caught at input scales 1e-20 and 1e20") {
+  // d/dx of x * detach(x) is x: half the true 2x. Correct ops at the same inputs pass.
+  for (double s : {1e-20, 1e20}) {
+    CAPTURE(s);
+    const ag::Tensord x = ag::Tensord::from({2, 3}, {0.5 * s, -1.0 * s, 2.0 * s, 1.5 * s, -0.7 * s, 1.1 * s});
+    const auto wrong =
+        ag::gradcheck([](const std::vector<ag::Tensord>& in) { return ag::mul(in[0], in[0].detach()); }, {x});
+    INFO(wrong.report());
+    CHECK(wrong.max_rel_error > 0.4);
+    const auto right = ag::gradcheck([](const std::vector<ag::Tensord>& in) { return ag::mul(in[0], in[0]); }, {x});
+    CHECK_MESSAGE(right.max_rel_error < 1e-6, right.report());
+    const auto smooth = ag::gradcheck(
+        [s](const std::vector<ag::Tensord>& in) { return ag::tanh(ag::mul_scalar(in[0], 1.0 / s)); }, {x});
+    CHECK_MESSAGE(smooth.max_rel_error < 1e-6, smooth.report());
+  }
+}

@@ -15,11 +15,9 @@ TEST_CASE("norm: channel_norm and layer_norm on random inputs") {
     INFO("scale " << s);
     // eps = 1e-5 against a variance of ~1e-6 at scale 1e-3: still a smooth function.
     check_grad(
-        "channel_norm scaled", kTol, [](auto& in) { return ag::channel_norm(in[0]); }, {randn({7, 4}, 2, s)},
-        step_for_scale(s));
+        "channel_norm scaled", kTol, [](auto& in) { return ag::channel_norm(in[0]); }, {randn({7, 4}, 2, s)});
     check_grad(
-        "layer_norm scaled", kTol, [](auto& in) { return ag::layer_norm(in[0]); }, {randn({7, 4}, 3, s)},
-        step_for_scale(s));
+        "layer_norm scaled", kTol, [](auto& in) { return ag::layer_norm(in[0]); }, {randn({7, 4}, 3, s)});
   }
 }
 
@@ -73,4 +71,68 @@ TEST_CASE("norm: float32 matches float64 within 1e-5") {
   const Tensord x = randn({300, 8}, 8);
   CHECK(max_abs_diff(ag::channel_norm(to_float(x)), ag::channel_norm(x)) < 1e-5);
   CHECK(max_abs_diff(ag::layer_norm(to_float(x)), ag::layer_norm(x)) < 1e-5);
+}
+
+TEST_CASE("norm: rows near the float range's ends give the exact O(1) result") {
+  // float32 rows of size 1e20 (squares overflow) and 1e-30 (squares underflow), float64 rows
+  // of size 1e160 and 1e-200: compared with the float64 formula on the unscaled pattern.
+  const Tensord p = randn({3, 5}, 30);
+  auto reference = [&p](double s, double eps, bool per_row) {
+    Eigen::MatrixXd m = p.mat(), out(m.rows(), m.cols());
+    for (int k = 0; k < (per_row ? m.rows() : m.cols()); ++k) {
+      Eigen::VectorXd v = per_row ? Eigen::VectorXd(m.row(k).transpose()) : Eigen::VectorXd(m.col(k));
+      const double mu = v.mean(), var = (v.array() - mu).square().mean();
+      // (s x - s mu) / sqrt(s^2 var + eps) = (x - mu) / sqrt(var + eps / s^2)
+      const Eigen::VectorXd o = (v.array() - mu) / std::sqrt(var + eps / s / s);
+      if (per_row)
+        out.row(k) = o.transpose();
+      else
+        out.col(k) = o;
+    }
+    return out;
+  };
+  auto check = [&](auto s, double tol) {
+    using T = decltype(s);
+    std::vector<T> v;
+    for (double e : p.values()) v.push_back(static_cast<T>(e * double(s)));
+    const ag::Tensor<T> x = ag::Tensor<T>::from(p.shape(), v);
+    for (bool per_row : {true, false}) {
+      CAPTURE(per_row);
+      const ag::Tensor<T> y = per_row ? ag::layer_norm(x) : ag::channel_norm(x);
+      const Eigen::MatrixXd want = reference(double(s), 1e-5, per_row);
+      double err = 0;
+      for (int64_t i = 0; i < y.numel(); ++i)
+        err = std::max(err, std::abs(double(y.data()[i]) - want(i / p.cols(), i % p.cols())));
+      CHECK(err < tol);
+    }
+  };
+  for (float s : {1e20f, 1e35f, 1e-30f}) {
+    CAPTURE(s);
+    check(s, 1e-5);
+  }
+  for (double s : {1e160, 1e300, 1e-200}) {
+    CAPTURE(s);
+    check(s, 1e-12);
+  }
+  // float64 gradient checks there (gradcheck's step and floor are relative to the inputs)
+  for (double s : {1e160, 1e-200}) {
+    CAPTURE(s);
+    check_grad("layer_norm extreme", kTol, [](auto& in) { return ag::layer_norm(in[0]); }, {randn({4, 5}, 31, s)});
+    check_grad("channel_norm extreme", kTol, [](auto& in) { return ag::channel_norm(in[0]); }, {randn({5, 4}, 32, s)});
+  }
+  // float32 gradient at 1e20 agrees with float64's
+  const Tensord xd = (randn({3, 5}, 33) * 1e20).detach().set_requires_grad(true);
+  Tensorf xf = to_float(xd).set_requires_grad(true);
+  const Tensord w = randn({3, 5}, 34);
+  sum(ag::layer_norm(xd) * w).backward();
+  sum(ag::layer_norm(xf) * to_float(w)).backward();
+  for (size_t i = 0; i < xd.grad().size(); ++i)
+    CHECK(double(xf.grad()[i]) == doctest::Approx(xd.grad()[i]).epsilon(1e-4));
+}
+
+TEST_CASE("norm: eps must be finite and positive") {
+  const Tensord x = randn({3, 4}, 35);
+  CHECK_THROWS_WITH_AS(ag::layer_norm(x, 0.0), doctest::Contains("layer_norm: eps"), ag::Error);
+  CHECK_THROWS_WITH_AS(ag::channel_norm(x, -1e-5), doctest::Contains("channel_norm: eps"), ag::Error);
+  CHECK_THROWS_AS(ag::layer_norm(x, std::nan("")), ag::Error);
 }

@@ -56,7 +56,7 @@ TEST_CASE("vec3: zero vectors through norm_rows and normalize_rows") {
 TEST_CASE("vec3: inputs scaled by 1e-3 and 1e3") {
   for (double s : {1e-3, 1e3}) {
     INFO("scale " << s);
-    const ag::GradCheckOptions opt = step_for_scale(s);
+    const ag::GradCheckOptions opt;  // gradcheck's step is relative to the input's size
     const Tensord a = randn({5, 3}, 8, s), b = randn({5, 3}, 9, s);
     check_grad(
         "dot scaled", kTol, [](auto& in) { return ag::dot_rows(in[0], in[1]); }, {a, b}, opt);
@@ -89,4 +89,53 @@ TEST_CASE("vec3: float32 matches float64 within 1e-5") {
   CHECK(max_abs_diff(ag::dot_rows(to_float(a), to_float(b)), ag::dot_rows(a, b)) < 1e-5);
   CHECK(max_abs_diff(ag::norm_rows(to_float(a)), ag::norm_rows(a)) < 1e-5);
   CHECK(max_abs_diff(ag::normalize_rows(to_float(a)), ag::normalize_rows(a)) < 1e-5);
+}
+
+TEST_CASE("vec3: norm_rows and normalize_rows at subnormal and near-overflow lengths") {
+  // Rows (3a, 4a, 0): |x| = 5a, d|x|/dx = x/|x| = (0.6, 0.8, 0) and normalize = (0.6, 0.8, 0)
+  // at every magnitude a, float32 and float64 (expected finite values, not only "no NaN").
+  auto check = [](auto a, bool norm_overflows) {
+    using T = decltype(a);
+    ag::Tensor<T> x = ag::Tensor<T>::from({1, 3}, {T(3) * a, T(4) * a, T(0)}, true);
+    const ag::Tensor<T> n = ag::norm_rows(x);
+    if (norm_overflows)
+      CHECK(std::isinf(n.item()));  // 5a itself exceeds the largest float
+    else
+      CHECK(double(n.item()) == doctest::Approx(5 * double(a)).epsilon(1e-6));
+    sum(n).backward();
+    CHECK(double(x.grad()[0]) == doctest::Approx(0.6).epsilon(1e-6));
+    CHECK(double(x.grad()[1]) == doctest::Approx(0.8).epsilon(1e-6));
+    CHECK(x.grad()[2] == T(0));
+    // normalize with the smallest positive eps: the exact unit vector
+    const ag::Tensor<T> u = ag::normalize_rows(x.detach(), std::numeric_limits<T>::denorm_min());
+    CHECK(double(u.at(0, 0)) == doctest::Approx(0.6).epsilon(1e-6));
+    CHECK(double(u.at(0, 1)) == doctest::Approx(0.8).epsilon(1e-6));
+  };
+  for (float a : {1e-40f, 1e-20f, 1e20f, 5e37f}) {
+    CAPTURE(a);
+    check(a, false);
+  }
+  check(7.5e37f, true);  // 4a is finite, 5a is not
+  for (double a : {6e-311, 1e-160, 1e160, 3e307}) {
+    CAPTURE(a);
+    check(a, false);
+  }
+  check(4e307, true);
+  // normalize's gradient (g - y (y.g)) / |x| near overflow: ~1/|x|, finite and right
+  ag::Tensord x = ag::Tensord::from({1, 3}, {3e307, 4e307, 0}, true);
+  sum(ag::normalize_rows(x) * ag::Tensord::from({1, 3}, {0.0, 0.0, 1.0})).backward();
+  CHECK(x.grad()[2] == doctest::Approx(1.0 / 5e307));
+  CHECK(x.grad()[0] == 0.0);
+}
+
+TEST_CASE("vec3: gradient checks at 1e-150 and 1e150 and eps must be positive") {
+  for (double s : {1e-150, 1e150}) {
+    CAPTURE(s);
+    const Tensord a = randn({5, 3}, 21, s);
+    check_grad("norm extreme", kTol, [](auto& in) { return ag::norm_rows(in[0]); }, {a});
+    check_grad("normalize extreme", kTol, [](auto& in) { return ag::normalize_rows(in[0], 1e-300); }, {a});
+  }
+  const Tensord a = randn({2, 3}, 22);
+  CHECK_THROWS_WITH_AS(ag::normalize_rows(a, 0.0), doctest::Contains("eps"), ag::Error);
+  CHECK_THROWS_AS(ag::normalize_rows(a, -1.0), ag::Error);
 }

@@ -145,7 +145,13 @@ TEST_CASE("MLPBlock: forward matches its definition; float64 gradient check with
   for (auto& [n, p] : blk.named_parameters())
     if (n != "linear2.bias") inputs.push_back(p);
   CHECK(inputs.size() == 6);
-  const auto r = ag::gradcheck([&](const std::vector<ag::Tensord>&) { return blk.forward(inputs[0]); }, inputs);
+  // Step 2e-6 of each input's largest entry: the parameters are at most ~0.5, and h = 1e-6 *
+  // 0.5 lets round-off of the 28-output loss (~8e-9 on a gradient that is exactly 0) reach
+  // 1.6e-6 of the largest bias gradient; at 2e-6 it is half that.
+  ag::GradCheckOptions opt;
+  opt.step = 2e-6;
+  const auto r =
+      ag::gradcheck([&](const std::vector<ag::Tensord>&) { return blk.forward(inputs[0]); }, inputs, opt);
   CHECK_MESSAGE(r.max_rel_error < 1e-6, r.report());
   blk.zero_grad();
   ag::sum(ag::mul(blk.forward(x), blk.forward(x))).backward();

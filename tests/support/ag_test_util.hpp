@@ -83,14 +83,6 @@ inline ag::GradCheckResult check_grad(const std::string& what, double tol, const
   return r;
 }
 
-// Options for inputs of magnitude ~s: gradcheck's step is h = step * max(1, |x|), i.e.
-// absolute for |x| < 1, so for small inputs it is scaled down to keep h / |x| ~ 1e-6.
-inline ag::GradCheckOptions step_for_scale(double s) {
-  ag::GradCheckOptions o;
-  o.step = 1e-6 * std::min(1.0, s);
-  return o;
-}
-
 // For functions linear in every single input entry (linear, matmul, conv): central
 // differences are exact up to round-off, so a large step removes the round-off that
 // otherwise dominates when |L| is much larger than a gradient entry (inputs scaled 1e3).

@@ -139,7 +139,7 @@ TEST_CASE("losses: coarse terms vanish at the ground truth and pass float64 grad
       INFO(term);
       const LossConfig cfg = only(term);
       ag::GradCheckOptions opt;
-      opt.step = scale <= 1 ? 1e-6 * scale : 1e-7;  // h ~ 1e-6 of the mesh size (see test_geometry_ad)
+      opt.step = scale <= 1 ? 1e-6 : 1e-7;  // h ~ 1e-6 of the mesh size (see test_geometry_ad)
       const ag::GradCheckResult r =
           ag::gradcheck([&](const std::vector<ag::Tensord>& in) { return coarse_loss(cfg, t, in[0], gt).total; },
                         {to_tensor<double>(pred)}, opt);
@@ -209,13 +209,67 @@ TEST_CASE("losses: fine loss over a patch batch, with an image-loss callback, fl
   for (const char* term : {"f_position", "f_vgg", "f_image_l1", "f_strain", "f_smooth"}) {
     CAPTURE(term);
     const LossConfig cfg = only(term);
+    // Step 4e-6 of the largest |x| (~0.25 m, so h ~ 1e-6): at 1e-6 (h ~ 2.5e-7) round-off on
+    // the smallest gradient entries reaches 1.1e-6.
+    ag::GradCheckOptions opt;
+    opt.step = 4e-6;
     const ag::GradCheckResult r =
         ag::gradcheck([&](const std::vector<ag::Tensord>& in) { return fine_loss(cfg, b, in[0], gt, mse).total; },
-                      {rows_of(pred, b.vertices)});
+                      {rows_of(pred, b.vertices)}, opt);
     INFO(r.report());
     CHECK(r.max_rel_error < 1e-6);
   }
   const FineLoss<float> f = fine_loss<float>(LossConfig{}, b, to_tensor<float>(rows_of(pred, b.vertices).mat()), gt);
   CHECK(f.total.item() ==
         doctest::Approx(fine_loss(LossConfig{}, b, rows_of(pred, b.vertices), gt).total.item()).epsilon(1e-4));
+}
+
+TEST_CASE("losses: a predicted sliver's dihedral gradient stays bounded as its height goes to 0") {
+  // The dihedral angle's gradient is 1 / height on a sliver; weighting each pair by |n0| |n1|
+  // (the eps-normalised normals shrink once |cross| < normal_eps) caps it at ~ edge /
+  // normal_eps, independent of the height. Unweighted, 1e-12 m would give 1000x 1e-9 m's.
+  const GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec::spaced(5, 0.05));
+  const MeshTopology t = make_topology(g);
+  const Points3 gt = gdsr_test::bumpy(g.V, 0.2, 1.0, 1);
+  const Points3 base = gdsr_test::bumpy(g.V, 0.2, 1.0, 2);
+  const int f0 = 12;
+  const int a = g.F(f0, 0), b = g.F(f0, 1), c = g.F(f0, 2);
+  const LossConfig cfg = only("c_dihedral");
+  auto sliver_gradient = [&](double h, double* healthy) {
+    Points3 pred = base;
+    const Eigen::RowVector3d e = (pred.row(c) - pred.row(b)).normalized();
+    const Eigen::RowVector3d up = e.cross(Eigen::RowVector3d(0, 0, 1)).normalized().cross(e);
+    pred.row(a) = 0.5 * (pred.row(b) + pred.row(c)) + h * up;
+    ag::Tensord x = to_tensor<double>(pred);
+    x.set_requires_grad(true);
+    coarse_loss(cfg, t, x, gt).total.backward();
+    REQUIRE(finite(x.grad()));
+    double worst = 0, rest = 0;
+    for (int i = 0; i < t.num_vertices; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const double v = std::abs(x.grad()[3 * i + k]);
+        if (i == a || i == b || i == c)
+          worst = std::max(worst, v);
+        else
+          rest = std::max(rest, v);
+      }
+    if (healthy) *healthy = rest;
+    return worst;
+  };
+  double healthy = 0;
+  const double g9 = sliver_gradient(1e-9, &healthy), g12 = sliver_gradient(1e-12, nullptr);
+  MESSAGE("dihedral gradient on a sliver: " << g9 << " at 1e-9 m, " << g12 << " at 1e-12 m; healthy max " << healthy);
+  CHECK(g12 < 2 * g9);
+  CHECK(sliver_gradient(0.0, nullptr) < 2 * g9);
+  CHECK(g9 < 2 * 0.05 / t.normal_eps);  // edge / normal_eps (the loss is a mean over pairs: less)
+}
+
+TEST_CASE("losses: the dihedral weighting leaves healthy meshes unchanged") {
+  const GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec::spaced(5, 0.05));
+  const MeshTopology t = make_topology(g);
+  const Points3 gt = gdsr_test::bumpy(g.V, 0.2, 1.0, 1), pred = gdsr_test::bumpy(g.V, 0.3, 1.0, 2);
+  const CoarseLoss<double> l = coarse_loss(only("c_dihedral"), t, to_tensor<double>(pred), gt);
+  const ag::Tensord plain =
+      ag::l1_loss(dihedral_angles(to_tensor<double>(pred), t), dihedral_angles(to_tensor<double>(gt), t));
+  CHECK(l.dihedral == doctest::Approx(plain.item()).epsilon(1e-14));
 }

@@ -22,6 +22,16 @@ int64_t stack(std::vector<int64_t> w) {
   for (size_t k = 0; k + 1 < w.size(); ++k) n += block(w[k], w[k + 1]);
   return n;
 }
+
+// The error message of parsing `text` as a config ("" if it is accepted).
+std::string msg(const std::string& text) {
+  try {
+    model_config_from_json_text(text, "test");
+  } catch (const std::runtime_error& e) {
+    return std::string(e.what());
+  }
+  return std::string();
+}
 }  // namespace
 
 TEST_CASE("model params: paper preset parameter count and field size") {
@@ -71,14 +81,6 @@ TEST_CASE("model params: presets load, validate and round-trip through JSON") {
 }
 
 TEST_CASE("model params: bad configs throw clear errors") {
-  auto msg = [](const std::string& text) {
-    try {
-      model_config_from_json_text(text, "test");
-    } catch (const std::runtime_error& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
   CHECK(msg(R"({"mp_stepz": 3})").find("unknown key 'mp_stepz'") != std::string::npos);
   CHECK(msg(R"({"mp_steps": "six"})").find("bad value for 'mp_steps'") != std::string::npos);
   CHECK(msg(R"({"edge_encoder": [9, 64, 32]})").find("edge_encoder") != std::string::npos);
@@ -87,4 +89,22 @@ TEST_CASE("model params: bad configs throw clear errors") {
   CHECK(msg("{not json").find("not valid JSON") != std::string::npos);
   CHECK(msg(R"({"_comment": "ok", "mp_steps": 2})").empty());
   CHECK_THROWS_AS(load_model_config(kConfigs + "does_not_exist.json"), std::runtime_error);
+}
+
+TEST_CASE("model params: values outside the domain of the maths are refused naming the key") {
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {R"({"wire_s0": 0})", "wire_s0"},         {R"({"wire_s0": -2})", "wire_s0"},
+      {R"({"wire_omega0": -1})", "wire_omega0"}, {R"({"frame_eps": 0})", "frame_eps"},
+      {R"({"frame_eps": -1e-6})", "frame_eps"},  {R"({"frame_eps": 1.5})", "frame_eps"},
+      {R"({"sigma_l": 0})", "sigma_l"},          {R"({"noise_std": -0.1})", "noise_std"},
+      {R"({"field_width": -4})", "field_width"}, {R"({"e_widths": [1536, -128, 64]})", "e_widths"},
+  };
+  for (const auto& [text, key] : bad) {
+    CAPTURE(text);
+    const std::string m = msg(text);
+    CHECK(m.find(key) != std::string::npos);
+    CHECK(m.find('\n') == std::string::npos);  // one line
+  }
+  CHECK(msg(R"({"wire_s0": 0})").find("got 0") != std::string::npos);
+  CHECK(msg(R"({"wire_s0": 0.5, "frame_eps": 1e-6})").empty());
 }

@@ -1,0 +1,164 @@
+// Local triangle frames of the model (triangle_frames_ad) and their plain twin
+// (triangle_frames): scale-free eps, unit orthonormal frames on healthy triangles at mm, m and
+// km scales, float64 gradient checks, and bounded gradients on degenerate triangles.
+#include <doctest/doctest.h>
+
+#include "autograd/autograd.hpp"
+#include "gdsr/geometry/mesh_ops.hpp"
+#include "gdsr/model/frames.hpp"
+#include "gdsr/model/model_config.hpp"
+#include "tests/support/grid_garment.hpp"
+#include "tests/support/loss_test_meshes.hpp"
+
+#include <cmath>
+#include <random>
+
+using namespace gdsr;
+
+namespace {
+
+const double kEps = ModelConfig().frame_eps;  // the model's default
+
+// Random healthy triangles (v0, v1, v2) = rows 3f .. 3f + 2, size ~1 before scaling.
+Points3 random_triangles(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> nd;
+  Points3 V(3 * n, 3);
+  for (int i = 0; i < V.size(); ++i) V.data()[i] = nd(rng);
+  return V;
+}
+
+Faces consecutive_faces(int n) {
+  Faces F(n, 3);
+  for (int f = 0; f < n; ++f) F.row(f) << 3 * f, 3 * f + 1, 3 * f + 2;
+  return F;
+}
+
+ag::Index all_faces(int n) {
+  ag::Index a(static_cast<size_t>(n));
+  for (int f = 0; f < n; ++f) a[f] = f;
+  return a;
+}
+
+// L = sum(w * local_to_world(r, frames)) for fixed random local vectors r (unit size) and
+// weights w, as E and A use the frames.
+ag::Tensord frame_loss(const ag::Tensord& X, const Faces& F, double eps) {
+  const int n = static_cast<int>(F.rows());
+  std::mt19937 rng(11);
+  std::normal_distribution<double> nd;
+  ag::Tensord r = ag::Tensord::zeros({n, 3}), w = ag::Tensord::zeros({n, 3});
+  for (double& v : r.values()) v = nd(rng);
+  for (double& v : w.values()) v = nd(rng);
+  return ag::sum(ag::mul(local_to_world(r, triangle_frames_ad(X, F, all_faces(n), eps)), w));
+}
+
+// Largest |dL/dx| per vertex.
+Eigen::VectorXd vertex_gradient(const Points3& V, const Faces& F, double eps) {
+  ag::Tensord X = to_tensor<double>(V);
+  X.set_requires_grad(true);
+  frame_loss(X, F, eps).backward();
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(V.rows());
+  for (int i = 0; i < V.rows(); ++i)
+    for (int k = 0; k < 3; ++k) g(i) = std::max(g(i), std::abs(X.grad()[3 * i + k]));
+  return g;
+}
+
+}  // namespace
+
+TEST_CASE("frames: unit orthonormal and identical at mm and m and km scales") {
+  const int n = 20;
+  const Points3 V = random_triangles(n, 1);
+  const Faces F = consecutive_faces(n);
+  const Frames ref = triangle_frames(V, F, kEps);
+  for (double s : {1e-3, 1.0, 1e3}) {
+    CAPTURE(s);
+    const ag::Tensord H = triangle_frames_ad(to_tensor<double>(Points3(V * s)), F, all_faces(n), kEps);
+    const Frames plain = triangle_frames(Points3(V * s), F, kEps);
+    for (int f = 0; f < n; ++f) {
+      Eigen::Matrix3d R;
+      for (int k = 0; k < 9; ++k) R(k / 3, k % 3) = H.at(f, k);
+      CHECK((R * R.transpose() - Eigen::Matrix3d::Identity()).norm() < 1e-14);
+      CHECK(R.determinant() == doctest::Approx(1.0).epsilon(1e-14));
+      for (int k = 0; k < 9; ++k) {
+        CHECK(std::abs(H.at(f, k) - ref(f, k)) < 1e-14);  // same frame as at 1 m
+        CHECK(std::abs(plain(f, k) - ref(f, k)) < 1e-14);
+      }
+    }
+  }
+  // The regular triangle with 1 mm edges of the issue: a unit normal (an absolute eps of
+  // 1e-6 m^2 gave 0.87).
+  Points3 T(3, 3);
+  T << 0, 0, 0, 1e-3, 0, 0, 0.5e-3, 0.5e-3 * std::sqrt(3.0), 0;
+  const ag::Tensord h = triangle_frames_ad(to_tensor<double>(T), consecutive_faces(1), all_faces(1), kEps);
+  CHECK(std::abs(h.at(0, 8)) == doctest::Approx(1.0).epsilon(1e-14));
+}
+
+TEST_CASE("frames: float64 gradient checks on healthy triangles at mm and m and km scales") {
+  const int n = 6;
+  const Faces F = consecutive_faces(n);
+  for (double s : {1e-3, 1.0, 1e3}) {
+    CAPTURE(s);
+    const Points3 V = random_triangles(n, 2) * s;
+    const ag::GradCheckResult r = ag::gradcheck(
+        [&](const std::vector<ag::Tensord>& in) { return triangle_frames_ad(in[0], F, all_faces(n), kEps); },
+        {to_tensor<double>(V)});
+    INFO(r.report());
+    CHECK(r.max_rel_error < 1e-6);
+  }
+}
+
+TEST_CASE("frames: a degenerate triangle's gradient stays bounded as it degenerates") {
+  // A 5 x 5 grid (2 cm spacing) in which one triangle is made a sliver of height h (its
+  // third vertex moved onto the opposite edge, then lifted by h), down to exactly 0, and
+  // then a triangle with two coincident vertices. The largest gradient on the degenerate
+  // triangle's corners must stay within ~2 / frame_eps of the healthy triangles' largest,
+  // whatever h: bounded, not growing as 1 / h (the reference's third normalisation and
+  // absolute eps gave ~1e12 here).
+  const GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec::spaced(5, 0.02));
+  const Points3 base = gdsr_test::bumpy(g.V, 0.2, 1.0, 3);
+  const int f0 = 12;  // an interior face
+  const int a = g.F(f0, 0), b = g.F(f0, 1), c = g.F(f0, 2);
+  auto healthy_max = [&](const Eigen::VectorXd& grad) {
+    double m = 0;
+    for (int i = 0; i < grad.size(); ++i)
+      if (i != a && i != b && i != c) m = std::max(m, grad(i));
+    return m;
+  };
+  const double healthy = healthy_max(vertex_gradient(base, g.F, kEps));
+  REQUIRE(healthy > 0);
+  std::vector<double> worst;
+  for (double h : {1e-4, 1e-8, 1e-12, 0.0}) {
+    CAPTURE(h);
+    Points3 V = base;
+    const Eigen::RowVector3d mid = 0.5 * (V.row(b) + V.row(c));
+    const Eigen::RowVector3d e = (V.row(c) - V.row(b)).normalized();
+    const Eigen::RowVector3d up = e.cross(Eigen::RowVector3d(0, 0, 1)).normalized().cross(e);
+    V.row(a) = mid + h * up;
+    const Eigen::VectorXd grad = vertex_gradient(V, g.F, kEps);
+    CHECK(grad.allFinite());
+    const double deg = std::max({grad(a), grad(b), grad(c)});
+    worst.push_back(deg);
+    MESSAGE("sliver of height " << h << " m: largest gradient " << deg << " (healthy faces: " << healthy << ")");
+    CHECK(deg < 4.0 / kEps * healthy);
+  }
+  // below the threshold the bound does not depend on h at all
+  CHECK(worst[3] < 2 * worst[2]);
+  CHECK(worst[2] < 2 * worst[1]);
+  // coincident vertices (v2 = v1, so y's edge vanishes)
+  Points3 V = base;
+  V.row(c) = V.row(b);
+  const Eigen::VectorXd grad = vertex_gradient(V, g.F, kEps);
+  CHECK(grad.allFinite());
+  CHECK(std::max({grad(a), grad(b), grad(c)}) < 4.0 / kEps * healthy);
+  // a triangle collapsed to a point: zero frame, finite gradient
+  V.row(a) = V.row(b);
+  CHECK(vertex_gradient(V, g.F, kEps).allFinite());
+  const ag::Tensord H = triangle_frames_ad(to_tensor<double>(V), g.F, ag::Index{f0}, kEps);
+  for (int k = 0; k < 9; ++k) CHECK(H.at(0, k) == 0.0);
+}
+
+TEST_CASE("frames: eps must be positive") {
+  const Points3 V = random_triangles(1, 3);
+  CHECK_THROWS_WITH_AS(triangle_frames_ad(to_tensor<double>(V), consecutive_faces(1), all_faces(1), 0.0),
+                       doctest::Contains("eps"), std::runtime_error);
+}
