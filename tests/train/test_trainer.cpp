@@ -65,7 +65,7 @@ TEST_CASE("trainer: the loss of a tiny model falls on a waving sheet, checkpoint
   CHECK(nn::load_checkpoint<float>(o.checkpoint, model, nullptr).step == 360);
 }
 
-TEST_CASE("trainer: a non-finite loss stops training with a message and keeps the last checkpoint") {
+TEST_CASE("trainer: a NaN loss weight is refused and the last checkpoint kept") {
   const gdsr::Dataset d = gdsr_test::wave_dataset(5);
   gdsr_test::TempDir dir("trainer_nan");
   gdsr::TrainOptions o = tiny_options();
@@ -79,7 +79,8 @@ TEST_CASE("trainer: a non-finite loss stops training with a message and keeps th
   o.resume = o.checkpoint;
   o.max_steps = 5;
   o.loss.c_position.weight = std::nan("");
-  CHECK_THROWS_WITH_AS(gdsr::train_gdsr({&d}, o), doctest::Contains("training stopped at step 3"), std::runtime_error);
+  CHECK_THROWS_WITH_AS(gdsr::train_gdsr({&d}, o), doctest::Contains("loss weight c_position must be finite"),
+                       std::runtime_error);
   gdsr::GDSR<float> model(o.model);
   CHECK(nn::load_checkpoint<float>(o.checkpoint, model, nullptr).step == 2);  // the last good one
 }
