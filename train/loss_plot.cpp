@@ -41,6 +41,13 @@ void draw_loss_plot(const std::string& path, const std::string& title, const std
     const int y = px(0, std::pow(10.0, e)).y;
     cv::line(img, {area.x, y}, {area.x + area.width, y}, grey, 1);
     cv::putText(img, "1e" + std::to_string(e), {8, y + 5}, font, 0.45, black, 1, cv::LINE_AA);
+    if (hi - lo > 3 || e == static_cast<int>(hi)) continue;
+    for (int m : {2, 5}) {  // minor lines when few decades show
+      const int ym = px(0, m * std::pow(10.0, e)).y;
+      cv::line(img, {area.x, ym}, {area.x + area.width, ym}, cv::Scalar(235, 235, 235), 1);
+      cv::putText(img, std::to_string(m) + "e" + std::to_string(e), {8, ym + 5}, font, 0.4, cv::Scalar(90, 90, 90), 1,
+                  cv::LINE_AA);
+    }
   }
   for (int i = 0; i <= 4; ++i) {
     const int64_t step = x_max * i / 4;

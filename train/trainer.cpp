@@ -58,8 +58,8 @@ struct TrainState {
   std::unique_ptr<nn::VGG19Features<float>> vgg;
   ImageLossFn<float> image_loss;  // empty: no VGG term
   std::vector<std::pair<std::string, ag::Tensor<float>>> named;
-  std::mt19937_64 rng;  // frame order and patches
-  nn::Rng noise{0};     // training noise on the history
+  std::mt19937_64 rng;  // frame order and one patch seed per frame
+  nn::Rng noise{0};     // one seed per frame for the training noise on the history
   TrainProgress p;      // step, data position, best figure (the RNGs live above while running)
   std::string last_good;  // the newest checkpoint of this run on disk ("" = none)
   int64_t first_step = 0, total = 0;
@@ -90,9 +90,9 @@ void restore_progress(TrainState& s, const nn::Checkpoint& ck, const std::string
   if (s.p.frames_per_epoch != static_cast<int64_t>(s.frames.size()))
     gdsr::fail(path, "was trained on " + std::to_string(s.p.frames_per_epoch) + " frames per epoch, the data given has " +
                          std::to_string(s.frames.size()));
-  if (s.p.frames_per_step != opt.frames_per_step)
+  if (s.p.frames_per_step != opt.frames_per_step * opt.ranks)
     gdsr::fail(path, "was trained with " + std::to_string(s.p.frames_per_step) + " frames per step, not " +
-                         std::to_string(opt.frames_per_step));
+                         std::to_string(opt.frames_per_step * opt.ranks) + " (frames per step x ranks)");
   for (const auto& [si, t] : s.p.order)
     if (si < 0 || si >= static_cast<int>(s.seqs.size()) || t < 2 ||
         t >= static_cast<int>(s.seqs[static_cast<size_t>(si)].d->lr_frames.size()))
@@ -117,7 +117,7 @@ void start_training(TrainState& s, const std::vector<const Dataset*>& data, cons
   ao.weight_decay = opt.weight_decay;
   ao.amsgrad = opt.amsgrad;
   s.adam = std::make_unique<nn::AdamW<float>>(s.model->named_parameters(), ao);
-  s.p.frames_per_step = opt.frames_per_step;
+  s.p.frames_per_step = opt.frames_per_step * opt.ranks;
   s.p.frames_per_epoch = static_cast<int64_t>(s.frames.size());
   s.rng.seed(opt.seed);
   s.noise = nn::Rng(opt.seed * 7919 + 1);
@@ -127,11 +127,11 @@ void start_training(TrainState& s, const std::vector<const Dataset*>& data, cons
     s.last_good = opt.resume;
   }
 
-  const int64_t frames = s.p.frames_per_epoch * opt.epochs;
-  if (frames < opt.frames_per_step)
+  const int64_t frames = s.p.frames_per_epoch * opt.epochs, per_step = int64_t{opt.frames_per_step} * opt.ranks;
+  if (frames < per_step)
     gdsr::fail("train", std::to_string(opt.epochs) + " epoch(s) of " + std::to_string(s.p.frames_per_epoch) +
-                            " frames hold fewer frames than one step of " + std::to_string(opt.frames_per_step));
-  s.total = frames / opt.frames_per_step;
+                            " frames hold fewer frames than one step of " + std::to_string(per_step));
+  s.total = frames / per_step;
   if (opt.max_steps > 0) s.total = std::min(s.total, opt.max_steps);
   if (s.p.step >= s.total)
     gdsr::fail(opt.resume, "is already at step " + std::to_string(s.p.step) + " of " + std::to_string(s.total) +
@@ -236,9 +236,46 @@ double checked_grad_norm(const TrainState& s) {
   return std::sqrt(sum);
 }
 
-// One optimizer step on the next frames_per_step frames: forward, losses, finite checks,
-// backward (accumulated), AdamW. Throws before the parameters are touched when a loss term
-// or a gradient is not finite.
+// Sums the step's log figures and every gradient over the ranks (data-parallel training);
+// a parameter without a gradient on any rank keeps none, as in one process.
+void reduce_over_ranks(TrainState& s, TrainLog& L, const TrainOptions& opt) {
+  std::vector<double> buf = {L.loss, L.coarse, L.fine};
+  for (const auto& [name, v] : L.terms) buf.push_back(v);
+  for (const auto& [name, p] : s.named) {
+    buf.push_back(p.has_grad() ? 1.0 : 0.0);
+    if (p.has_grad())
+      buf.insert(buf.end(), p.grad().begin(), p.grad().end());
+    else
+      buf.insert(buf.end(), static_cast<size_t>(p.numel()), 0.0);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  opt.allreduce_sum(buf);
+  L.allreduce_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  size_t i = 0;
+  L.loss = buf[i++];
+  L.coarse = buf[i++];
+  L.fine = buf[i++];
+  for (auto& [name, v] : L.terms) v = buf[i++];
+  for (auto& [name, p] : s.named) {
+    const bool any = buf[i++] > 0;
+    auto& g = p.node().grad;
+    if (any) g.resize(static_cast<size_t>(p.numel()));
+    for (int64_t k = 0; k < p.numel(); ++k, ++i)
+      if (any) g[static_cast<size_t>(k)] = static_cast<float>(buf[i]);
+    if (!any) g.clear();
+  }
+  const std::string at = "training stopped at step " + std::to_string(s.p.step + 1);
+  for (const auto& [name, v] : L.terms)
+    if (!std::isfinite(v)) gdsr::fail(at, "loss term " + name + " is " + value_text(v) + " on a rank" + last_good(s));
+  if (!std::isfinite(L.loss)) gdsr::fail(at, "the weighted loss total is " + value_text(L.loss) + last_good(s));
+}
+
+// One optimizer step on the next frames_per_step x ranks frames (this rank takes every
+// ranks-th one): forward, losses, finite checks, backward (accumulated), the sum over
+// ranks, AdamW. Every frame draws one seed from each main RNG stream for its patches and
+// noise whichever rank computes it, so the streams (and the result) do not depend on the
+// number of ranks. Throws before the parameters are touched when a loss term or a gradient
+// is not finite.
 TrainLog train_step(TrainState& s, const TrainOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   const nn::StepDecay decay{opt.lr, 0.5, opt.lr_halve_every, opt.lr_floor};
@@ -246,7 +283,7 @@ TrainLog train_step(TrainState& s, const TrainOptions& opt) {
   s.adam->zero_grad();
 
   TrainLog L;
-  const int K = opt.frames_per_step;
+  const int K = opt.frames_per_step * opt.ranks;
   const double inv = 1.0 / K;
   for (int k = 0; k < K; ++k) {
     const auto [si, t] = next_frame(s);
@@ -254,7 +291,10 @@ TrainLog train_step(TrainState& s, const TrainOptions& opt) {
     const Lambdas lambdas = opt.loss.schedule ? lambda_schedule(opt.loss, L.epoch) : Lambdas{1, 1};
     L.lambda_c = lambdas.coarse;
     L.lambda_w = lambdas.fine;
-    FrameLoss f = frame_loss(s, s.seqs[static_cast<size_t>(si)], t, lambdas, s.rng, &s.noise, opt);
+    std::mt19937_64 patch_rng(s.rng());
+    nn::Rng noise(s.noise.next());
+    if (k % opt.ranks != opt.rank) continue;
+    FrameLoss f = frame_loss(s, s.seqs[static_cast<size_t>(si)], t, lambdas, patch_rng, &noise, opt);
     check_finite_loss(s, f, si, t);
     L.loss += inv * f.total.item();
     L.coarse += inv * f.coarse;
@@ -265,6 +305,7 @@ TrainLog train_step(TrainState& s, const TrainOptions& opt) {
     else
       (f.total * static_cast<float>(inv)).backward();
   }
+  if (opt.ranks > 1) reduce_over_ranks(s, L, opt);
   L.step = s.p.step + 1;
   L.total_steps = s.total;
   L.lr = s.adam->lr();
@@ -331,9 +372,9 @@ void write_state(TrainState& s, const std::string& path, const TrainOptions& opt
   nn::save_checkpoint(path, *s.model, s.adam.get(), s.p.step, meta.dump());
 }
 
-// The last good checkpoint and, when its figure is the lowest so far, the best one.
-void save_checkpoints(TrainState& s, TrainLog& L, const TrainOptions& opt) {
-  if (opt.checkpoint.empty() && opt.best_checkpoint.empty()) return;
+// Before a checkpoint: the finite check, the validation figures and whether this one is the
+// best so far (its figure the lowest yet).
+bool prepare_checkpoint(TrainState& s, TrainLog& L, const TrainOptions& opt) {
   check_finite_parameters(s);
   validate(s, L, opt);
   const double figure =
@@ -342,20 +383,25 @@ void save_checkpoints(TrainState& s, TrainLog& L, const TrainOptions& opt) {
   if (best) {
     s.p.has_best = true;
     s.p.best = figure;
+    s.res.best = figure;
   }
   s.p.interval_sum = 0;
   s.p.interval_count = 0;
+  L.checkpointed = true;
+  return best;
+}
+
+// The last good checkpoint and, when `best`, the best one.
+void write_checkpoints(TrainState& s, bool best, const TrainOptions& opt) {
   if (best) {
     write_state(s, opt.best_checkpoint, opt);
     s.res.best_checkpoint = opt.best_checkpoint;
-    s.res.best = figure;
   }
   if (!opt.checkpoint.empty()) {
     write_state(s, opt.checkpoint, opt);
     s.res.checkpoint = opt.checkpoint;
     s.last_good = opt.checkpoint;
   }
-  L.checkpointed = true;
 }
 
 }  // namespace
@@ -364,6 +410,9 @@ void validate_train_options(const TrainOptions& opt) {
   if (opt.epochs <= 0) gdsr::fail("train", "--epochs must be positive, got " + std::to_string(opt.epochs));
   if (opt.max_steps == 0 || opt.max_steps < -1)
     gdsr::fail("train", "--max-steps must be positive, got " + std::to_string(opt.max_steps));
+  if (opt.ranks <= 0 || opt.rank < 0 || opt.rank >= opt.ranks)
+    gdsr::fail("train", "rank " + std::to_string(opt.rank) + " of " + std::to_string(opt.ranks) + " is not valid");
+  if (opt.ranks > 1 && !opt.allreduce_sum) gdsr::fail("train", "several ranks need an all-reduce");
   if (opt.frames_per_step <= 0)
     gdsr::fail("train", "--frames-per-step must be positive, got " + std::to_string(opt.frames_per_step));
   if (!std::isfinite(opt.lr) || opt.lr <= 0) gdsr::fail("train", "--lr must be finite and > 0, got " + std::to_string(opt.lr));
@@ -398,9 +447,13 @@ TrainResult train_gdsr(const std::vector<const Dataset*>& data, const TrainOptio
   while (s.p.step < s.total) {
     TrainLog L = train_step(s, opt);
     record_step(s, L);
-    if (s.p.step == s.total || (opt.checkpoint_every > 0 && s.p.step % opt.checkpoint_every == 0))
-      save_checkpoints(s, L, opt);
+    // The log sees a step before its checkpoint does: a kill in between leaves a log that
+    // runs ahead of the checkpoint (the resumed run drops those rows), never one with a gap.
+    const bool save = (!opt.checkpoint.empty() || !opt.best_checkpoint.empty()) &&
+                      (s.p.step == s.total || (opt.checkpoint_every > 0 && s.p.step % opt.checkpoint_every == 0));
+    const bool best = save && prepare_checkpoint(s, L, opt);
     if (log) log(L);
+    if (save) write_checkpoints(s, best, opt);
   }
   close_epoch(s);
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - s.start).count();

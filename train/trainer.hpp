@@ -49,6 +49,11 @@ struct TrainOptions {
   std::string best_checkpoint;
   std::vector<const Dataset*> validation;  // scored (no gradient) at every checkpoint
   std::string resume;  // continue from this checkpoint (model, AdamW, data order, RNGs)
+  // Data-parallel training (train/mpi_ranks.hpp): this process is rank `rank` of `ranks`;
+  // a step covers frames_per_step frames on every rank, `allreduce_sum` sums a buffer over
+  // all ranks in place (needed when ranks > 1). Give checkpoint paths on one rank only.
+  int rank = 0, ranks = 1;
+  std::function<void(std::vector<double>&)> allreduce_sum;
 };
 
 // Throws a one-line gdsr::Error naming the option when a value is out of range (epochs,
@@ -63,6 +68,7 @@ struct TrainLog {
   double lambda_c = 1, lambda_w = 1, lr = 0;
   double seconds = 0;                   // wall time of this step
   double grad_norm = 0;                 // L2 norm of the (averaged) gradient of all parameters
+  double allreduce_seconds = 0;         // wall time of the sum over ranks (0 with one rank)
   std::map<std::string, double> terms;  // unweighted loss terms (means over the step's frames)
   bool checkpointed = false;            // a checkpoint was written after this step
   bool validated = false;               // val_* hold the validation figures of this step

@@ -5,6 +5,7 @@
 #include "gdsr/model/gdsr_model.hpp"
 #include "nn/checkpoint.hpp"
 #include "tests/support/data_fixtures.hpp"
+#include "tests/support/train_options.hpp"
 #include "train/trainer.hpp"
 
 #include <cmath>
@@ -17,12 +18,8 @@
 namespace {
 
 gdsr::TrainOptions resume_options() {
-  gdsr::TrainOptions o;
-  o.model = gdsr::load_model_config(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json");
-  o.patches.size = 32;
-  o.patches.count = 2;
-  o.vgg = false;  // no weights file needed; the VGG term has its own tests
-  o.lr = 3e-3;
+  gdsr::TrainOptions o = gdsr_test::tiny_train_options();
+  o.loss.schedule = true;
   o.lr_halve_every = 4;  // the lr schedule position matters in the resumed half
   o.epochs = 3;          // 6 frames per epoch; the lambda schedule moves every epoch
   o.loss.lambda_every_epochs = 1;
@@ -48,7 +45,7 @@ void check_identical(const std::string& a, const std::string& b) {
       CHECK(ea[i].name == eb[i].name);
       differ += ea[i].bytes != eb[i].bytes;
     }
-    CHECK_MESSAGE(differ == 0, prefix << ": " << differ << " of " << ea.size() << " entries differ");
+    CHECK_MESSAGE(differ == 0, std::string(prefix) << ": " << differ << " of " << ea.size() << " entries differ");
   }
 }
 
