@@ -3,6 +3,7 @@
 #include "train/losses.hpp"
 #include "gdsr/model/model_config.hpp"
 #include "gdsr/cli/progress_bar.hpp"
+#include "train/mpi_ranks.hpp"
 #include "train/run_log.hpp"
 #include "train/trainer.hpp"
 #include "gdsr/cli/commands.hpp"
@@ -12,10 +13,12 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 namespace {
 
@@ -45,7 +48,11 @@ nlohmann::json command_json(const TrainArgs& a) {
   return j;
 }
 
-void run_train(TrainArgs& a) {
+void run_train(TrainArgs& a, const gdsr::MpiRanks& mpi) {
+  a.opt.rank = mpi.rank();
+  a.opt.ranks = mpi.size();
+  if (mpi.size() > 1) a.opt.allreduce_sum = [&mpi](std::vector<double>& buf) { mpi.allreduce_sum(buf); };
+  const bool writer = mpi.rank() == 0;  // rank 0 writes the checkpoints and logs and prints
   a.opt.model = gdsr::load_model_config(a.config);
   if (!a.loss_config.empty()) a.opt.loss = gdsr::load_loss_config(a.loss_config);
   if (a.no_schedule) a.opt.loss.schedule = false;
@@ -61,21 +68,30 @@ void run_train(TrainArgs& a) {
   std::vector<const gdsr::Dataset*> ptrs;
   for (const auto& s : sets) ptrs.push_back(&s);
   for (const auto& s : val_sets) a.opt.validation.push_back(&s);
-  std::filesystem::create_directories(a.out);
   const std::filesystem::path out(a.out);
-  a.opt.checkpoint = (out / "model.ckpt").string();
-  a.opt.best_checkpoint = (out / "model.best.ckpt").string();
+  if (writer) {
+    std::filesystem::create_directories(a.out);
+    a.opt.checkpoint = (out / "model.ckpt").string();
+    a.opt.best_checkpoint = (out / "model.best.ckpt").string();
+  }
+  if (writer && mpi.size() > 1)
+    std::printf("%d ranks, %d frame(s) per rank and step\n", mpi.size(), a.opt.frames_per_step);
   for (const auto& s : sets)
-    std::printf("dataset %s: %d frames, LR %d / HR %d vertices, %d layer(s)%s\n", s.manifest.garment.c_str(),
+    if (writer)
+      std::printf("dataset %s: %d frames, LR %d / HR %d vertices, %d layer(s)%s\n", s.manifest.garment.c_str(),
                 s.manifest.frames, s.manifest.lr_vertices, s.manifest.hr_vertices, s.manifest.layers,
                 s.has_body() ? ", body" : "");
 
-  gdsr::ProgressBar bar("train");
+  std::ostringstream silent;  // ranks other than 0 draw no progress
+  gdsr::ProgressBar bar("train", writer ? nullptr : &silent);
   auto progress = bar.callback();
   // The run log starts with the first step, so a run refused at the start (bad data, a
   // corrupt --resume) leaves the folder's earlier log in place.
   std::unique_ptr<gdsr::RunLog> run_log;
+  double allreduce_seconds = 0;
   const gdsr::TrainResult r = gdsr::train_gdsr(ptrs, a.opt, [&](const gdsr::TrainLog& L) {
+    allreduce_seconds += L.allreduce_seconds;
+    if (!writer) return;
     if (!run_log) {
       nlohmann::json cfg = gdsr::train_options_to_json(a.opt);
       cfg["command"] = command_json(a);
@@ -92,11 +108,15 @@ void run_train(TrainArgs& a) {
       std::fflush(stdout);
     }
   });
+  if (!writer) return;
   bar.finish();
   std::printf("trained %lld steps (%lld parameters), %.2f s/step; loss first epoch %.5g -> last epoch %.5g\n",
               static_cast<long long>(r.steps), static_cast<long long>(r.parameters), r.seconds_per_step,
               r.first_epoch_mean, r.last_epoch_mean);
   std::printf("checkpoint: %s (best: %s, %.5g)\n", r.checkpoint.c_str(), r.best_checkpoint.c_str(), r.best);
+  if (mpi.size() > 1)
+    std::printf("all-reduce: %.3g ms per step over %d ranks\n", 1e3 * allreduce_seconds / std::max<int64_t>(1, r.steps),
+                mpi.size());
   std::printf("log: %s, %s, %s\n", run_log->csv_path().c_str(), run_log->png_path().c_str(),
               (out / "config.json").string().c_str());
 }
@@ -127,5 +147,14 @@ void add_train_command(CLI::App& app) {
   c->add_flag("--no-fine", a->no_fine, "coarse correction only (no patches, no hyper-net)");
   c->add_flag("--no-vgg", a->no_vgg, "drop the VGG term of the fine loss");
   c->add_flag("--no-schedule", a->no_schedule, "lambda_c = lambda_w = 1 from the start");
-  c->callback([a]() { run_train(*a); });
+  c->callback([a]() {
+    gdsr::MpiRanks mpi;
+    if (mpi.size() == 1) return run_train(*a, mpi);
+    try {
+      run_train(*a, mpi);
+    } catch (const std::exception& e) {  // one rank's error must end every rank
+      std::fprintf(stderr, "gdsr: error: %s\n", e.what());
+      mpi.abort_all();
+    }
+  });
 }

@@ -236,33 +236,60 @@ double checked_grad_norm(const TrainState& s) {
   return std::sqrt(sum);
 }
 
-// Sums the step's log figures and every gradient over the ranks (data-parallel training);
-// a parameter without a gradient on any rank keeps none, as in one process.
-void reduce_over_ranks(TrainState& s, TrainLog& L, const TrainOptions& opt) {
+// The gradients of a step's frames summed in double, frame by frame (each frame's float
+// gradient computed from zero), then over the ranks: one process with K frames per step and
+// K ranks with one frame each add the same float gradients in the same pairs.
+struct GradientSum {
+  std::vector<std::vector<double>> g;  // per parameter; empty: no gradient yet
+  explicit GradientSum(size_t n) : g(n) {}
+  // Moves the parameters' gradients of one frame into the sum.
+  void take(const TrainState& s) {
+    for (size_t i = 0; i < s.named.size(); ++i) {
+      auto& p = s.named[i].second;
+      if (!p.has_grad()) continue;
+      if (g[i].empty()) g[i].assign(static_cast<size_t>(p.numel()), 0.0);
+      const auto& pg = p.grad();
+      for (size_t k = 0; k < pg.size(); ++k) g[i][k] += pg[k];
+      p.node().zero_grad();
+    }
+  }
+  // Writes the sum back as the parameters' gradients.
+  void give(const TrainState& s) const {
+    for (size_t i = 0; i < s.named.size(); ++i) {
+      auto& grad = s.named[i].second.node().grad;
+      grad.assign(g[i].begin(), g[i].end());
+    }
+  }
+};
+
+// Sums the step's log figures and gradients over the ranks; a parameter without a gradient
+// on every rank keeps none, as in one process. Then checks the summed loss terms.
+void reduce_over_ranks(TrainState& s, TrainLog& L, GradientSum& sum, const TrainOptions& opt) {
   std::vector<double> buf = {L.loss, L.coarse, L.fine};
   for (const auto& [name, v] : L.terms) buf.push_back(v);
-  for (const auto& [name, p] : s.named) {
-    buf.push_back(p.has_grad() ? 1.0 : 0.0);
-    if (p.has_grad())
-      buf.insert(buf.end(), p.grad().begin(), p.grad().end());
+  for (size_t i = 0; i < s.named.size(); ++i) {
+    buf.push_back(sum.g[i].empty() ? 0.0 : 1.0);
+    if (sum.g[i].empty())
+      buf.insert(buf.end(), static_cast<size_t>(s.named[i].second.numel()), 0.0);
     else
-      buf.insert(buf.end(), static_cast<size_t>(p.numel()), 0.0);
+      buf.insert(buf.end(), sum.g[i].begin(), sum.g[i].end());
   }
   const auto t0 = std::chrono::steady_clock::now();
   opt.allreduce_sum(buf);
   L.allreduce_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  size_t i = 0;
-  L.loss = buf[i++];
-  L.coarse = buf[i++];
-  L.fine = buf[i++];
-  for (auto& [name, v] : L.terms) v = buf[i++];
-  for (auto& [name, p] : s.named) {
-    const bool any = buf[i++] > 0;
-    auto& g = p.node().grad;
-    if (any) g.resize(static_cast<size_t>(p.numel()));
-    for (int64_t k = 0; k < p.numel(); ++k, ++i)
-      if (any) g[static_cast<size_t>(k)] = static_cast<float>(buf[i]);
-    if (!any) g.clear();
+  size_t j = 0;
+  L.loss = buf[j++];
+  L.coarse = buf[j++];
+  L.fine = buf[j++];
+  for (auto& [name, v] : L.terms) v = buf[j++];
+  for (size_t i = 0; i < s.named.size(); ++i) {
+    const bool any = buf[j++] > 0;
+    const size_t n = static_cast<size_t>(s.named[i].second.numel());
+    if (any)
+      sum.g[i].assign(buf.begin() + static_cast<std::ptrdiff_t>(j), buf.begin() + static_cast<std::ptrdiff_t>(j + n));
+    else
+      sum.g[i].clear();
+    j += n;
   }
   const std::string at = "training stopped at step " + std::to_string(s.p.step + 1);
   for (const auto& [name, v] : L.terms)
@@ -271,11 +298,10 @@ void reduce_over_ranks(TrainState& s, TrainLog& L, const TrainOptions& opt) {
 }
 
 // One optimizer step on the next frames_per_step x ranks frames (this rank takes every
-// ranks-th one): forward, losses, finite checks, backward (accumulated), the sum over
-// ranks, AdamW. Every frame draws one seed from each main RNG stream for its patches and
-// noise whichever rank computes it, so the streams (and the result) do not depend on the
-// number of ranks. Throws before the parameters are touched when a loss term or a gradient
-// is not finite.
+// ranks-th one): forward, losses, finite checks, backward, the gradient sum, AdamW. Every
+// frame draws one seed from each main RNG stream for its patches and noise whichever rank
+// computes it, so the streams do not depend on the number of ranks. Throws before the
+// parameters are touched when a loss term or a gradient is not finite.
 TrainLog train_step(TrainState& s, const TrainOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();
   const nn::StepDecay decay{opt.lr, 0.5, opt.lr_halve_every, opt.lr_floor};
@@ -285,6 +311,7 @@ TrainLog train_step(TrainState& s, const TrainOptions& opt) {
   TrainLog L;
   const int K = opt.frames_per_step * opt.ranks;
   const double inv = 1.0 / K;
+  GradientSum sum(K > 1 ? s.named.size() : 0);  // one frame: its gradient stays in place
   for (int k = 0; k < K; ++k) {
     const auto [si, t] = next_frame(s);
     if (k == 0) L.epoch = s.p.epoch;
@@ -300,12 +327,15 @@ TrainLog train_step(TrainState& s, const TrainOptions& opt) {
     L.coarse += inv * f.coarse;
     L.fine += inv * f.fine;
     for (const auto& [name, v] : f.terms) L.terms[name] += inv * v;
-    if (K == 1)
+    if (K == 1) {
       f.total.backward();
-    else
+    } else {
       (f.total * static_cast<float>(inv)).backward();
+      sum.take(s);
+    }
   }
-  if (opt.ranks > 1) reduce_over_ranks(s, L, opt);
+  if (opt.ranks > 1) reduce_over_ranks(s, L, sum, opt);
+  if (K > 1) sum.give(s);
   L.step = s.p.step + 1;
   L.total_steps = s.total;
   L.lr = s.adam->lr();
