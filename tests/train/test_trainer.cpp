@@ -15,7 +15,7 @@
 #include <filesystem>
 #include <map>
 
-using gdsr_test::tiny_train_options;
+const auto tiny_train_options = gdsr_test::tiny_train_options<gdsr::TrainOptions>;
 
 TEST_CASE("trainer: the loss of a tiny model falls on a waving sheet, checkpoints reload") {
   const gdsr::Dataset d = gdsr_test::wave_dataset();

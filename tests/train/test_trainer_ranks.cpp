@@ -48,7 +48,7 @@ class ThreadAllReduce {
 TEST_CASE("trainer: two ranks with one frame each match one process with two frames per step") {
   const gdsr::Dataset d = gdsr_test::wave_dataset();
   gdsr_test::TempDir dir("trainer_ranks");
-  gdsr::TrainOptions o = gdsr_test::tiny_train_options();
+  gdsr::TrainOptions o = gdsr_test::tiny_train_options<gdsr::TrainOptions>();
   o.epochs = 2;  // 6 steps of 2 frames, patches and training noise on
   o.frames_per_step = 2;
   o.checkpoint = dir / "one.ckpt";

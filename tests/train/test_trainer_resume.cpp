@@ -18,7 +18,7 @@
 namespace {
 
 gdsr::TrainOptions resume_options() {
-  gdsr::TrainOptions o = gdsr_test::tiny_train_options();
+  gdsr::TrainOptions o = gdsr_test::tiny_train_options<gdsr::TrainOptions>();
   o.loss.schedule = true;
   o.lr_halve_every = 4;  // the lr schedule position matters in the resumed half
   o.epochs = 3;          // 6 frames per epoch; the lambda schedule moves every epoch
