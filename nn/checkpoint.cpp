@@ -1,9 +1,13 @@
 #include "nn/checkpoint.hpp"
 
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <set>
+
+#include <fcntl.h>
+#include <unistd.h>
 
 namespace nn {
 
@@ -153,21 +157,36 @@ void write_checkpoint(const std::string& path, const Checkpoint& ck) {
   hd.pod<uint64_t>(pl.buf.size());
   hd.pod<uint64_t>(fnv1a64(pl.buf.data(), pl.buf.size()));
 
+  // Temp file, fsync, rename, fsync of the folder: after a crash or power loss the final
+  // name holds either the previous file or the complete new one.
   const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) throw ag::Error("checkpoint '" + path + "': cannot open '" + tmp + "' for writing");
-    f.write(reinterpret_cast<const char*>(hd.buf.data()), static_cast<std::streamsize>(hd.buf.size()));
-    f.write(reinterpret_cast<const char*>(pl.buf.data()), static_cast<std::streamsize>(pl.buf.size()));
-    f.flush();
-    if (!f) {
-      std::remove(tmp.c_str());
-      throw ag::Error("checkpoint '" + path + "': write failed (disk full?)");
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw ag::Error("checkpoint '" + path + "': cannot open '" + tmp + "' for writing");
+  auto write_all = [fd](const std::vector<uint8_t>& b) {
+    size_t done = 0;
+    while (done < b.size()) {
+      const ssize_t k = ::write(fd, b.data() + done, b.size() - done);
+      if (k < 0 && errno == EINTR) continue;
+      if (k <= 0) return false;
+      done += static_cast<size_t>(k);
     }
+    return true;
+  };
+  const bool ok = write_all(hd.buf) && write_all(pl.buf) && ::fsync(fd) == 0;
+  if (::close(fd) != 0 || !ok) {
+    std::remove(tmp.c_str());
+    throw ag::Error("checkpoint '" + path + "': write failed (disk full?)");
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());
     throw ag::Error("checkpoint '" + path + "': cannot rename the temporary file into place");
+  }
+  std::string dir = path.substr(0, path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/'));
+  if (dir.empty()) dir = path.find('/') == 0 ? "/" : ".";
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);  // best effort: some file systems refuse fsync on a folder
+    ::close(dfd);
   }
 }
 

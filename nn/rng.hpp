@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 namespace nn {
 
@@ -45,6 +46,25 @@ class Rng {
   }
   // Uniform integer in [0, n), n > 0.
   uint64_t below(uint64_t n) { return next() % n; }
+
+  // The whole generator state (for checkpoints): the four xoshiro words, the spare Gaussian
+  // as its IEEE bits, and whether the spare is pending. set_state(state()) continues the
+  // stream exactly.
+  struct State {
+    uint64_t s[4];
+    uint64_t spare_bits;
+    bool has_spare;
+  };
+  State state() const {
+    State st{{s_[0], s_[1], s_[2], s_[3]}, 0, has_spare_};
+    std::memcpy(&st.spare_bits, &spare_, sizeof spare_);
+    return st;
+  }
+  void set_state(const State& st) {
+    for (int i = 0; i < 4; ++i) s_[i] = st.s[i];
+    std::memcpy(&spare_, &st.spare_bits, sizeof spare_);
+    has_spare_ = st.has_spare;
+  }
 
  private:
   static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }

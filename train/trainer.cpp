@@ -5,12 +5,13 @@
 #include "autograd/autograd.hpp"
 #include "gdsr/data/frame_input.hpp"
 #include "gdsr/model/gdsr_model.hpp"
+#include "gdsr/model/model_checkpoint.hpp"
 #include "nn/adamw.hpp"
 #include "nn/checkpoint.hpp"
-#include "gdsr/model/model_checkpoint.hpp"
 #include "nn/feature_loss.hpp"
 #include "nn/lr_schedule.hpp"
 #include "nn/vgg.hpp"
+#include "train/train_state.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -19,6 +20,7 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 
 namespace gdsr {
@@ -35,6 +37,7 @@ struct Sequence {
 };
 
 Sequence prepare(const Dataset& d, const TrainOptions& opt) {
+  if (d.lr_frames.size() < 3) gdsr::fail("train", "a dataset needs at least 3 frames");
   Sequence s;
   s.d = &d;
   s.graph = build_graph(d.lr);
@@ -46,49 +49,93 @@ Sequence prepare(const Dataset& d, const TrainOptions& opt) {
   return s;
 }
 
-bool finite_gradients(const std::vector<ag::Tensor<float>>& params) {
-  for (const auto& p : params)
-    for (float g : p.grad())
-      if (!std::isfinite(g)) return false;
-  return true;
-}
-
 // Everything a training run carries from step to step.
 struct TrainState {
-  std::vector<Sequence> seqs;
+  std::vector<Sequence> seqs, val;
   std::vector<std::pair<int, int>> frames;  // (sequence, t), t >= 2: all training frames
-  std::vector<std::pair<int, int>> order;   // this epoch's shuffled frames
   std::unique_ptr<GDSR<float>> model;
   std::unique_ptr<nn::AdamW<float>> adam;
   std::unique_ptr<nn::VGG19Features<float>> vgg;
   ImageLossFn<float> image_loss;  // empty: no VGG term
-  std::vector<ag::Tensor<float>> params;
-  std::mt19937_64 rng;  // frame order and patches
-  nn::Rng noise{0};     // training noise on the history (seeded in start_training)
-  int64_t step = 0, first_step = 0, total = 0, per_epoch = 0;
-  int current_epoch = -1;
+  std::vector<std::pair<std::string, ag::Tensor<float>>> named;
+  std::mt19937_64 rng;  // frame order and one patch seed per frame
+  nn::Rng noise{0};     // one seed per frame for the training noise on the history
+  TrainProgress p;      // step, data position, best figure (the RNGs live above while running)
+  std::string last_good;  // the newest checkpoint of this run on disk ("" = none)
+  int64_t first_step = 0, total = 0;
+  int stat_epoch = -1;   // epoch of epoch_sum / epoch_count
   double epoch_sum = 0;  // loss summed over the current epoch
   int64_t epoch_count = 0;
+  bool first_epoch_closed = false;
   TrainResult res;
   std::chrono::steady_clock::time_point start;
 };
 
+void check_weight(const std::string& name, double w) {
+  if (!std::isfinite(w) || w < 0) gdsr::fail("train", "loss weight " + name + " must be finite and >= 0, got " + std::to_string(w));
+}
+
+// The state of the RNGs and the data position from a checkpoint written by this trainer.
+void restore_progress(TrainState& s, const nn::Checkpoint& ck, const std::string& path, const TrainOptions& opt) {
+  nlohmann::json meta;
+  try {
+    meta = nlohmann::json::parse(ck.metadata);
+  } catch (const std::exception&) {
+    gdsr::fail(path, "checkpoint metadata is not JSON");
+  }
+  if (!meta.contains("trainer"))
+    gdsr::fail(path, "holds no training state (data order, RNGs), so it cannot be resumed exactly");
+  s.p = progress_from_json(meta["trainer"], path);
+  if (s.p.step != ck.step) gdsr::fail(path, "training state is at another step than the checkpoint");
+  if (s.p.frames_per_epoch != static_cast<int64_t>(s.frames.size()))
+    gdsr::fail(path, "was trained on " + std::to_string(s.p.frames_per_epoch) + " frames per epoch, the data given has " +
+                         std::to_string(s.frames.size()));
+  if (s.p.frames_per_step != opt.frames_per_step * opt.ranks)
+    gdsr::fail(path, "was trained with " + std::to_string(s.p.frames_per_step) + " frames per step, not " +
+                         std::to_string(opt.frames_per_step * opt.ranks) + " (frames per step x ranks)");
+  for (const auto& [si, t] : s.p.order)
+    if (si < 0 || si >= static_cast<int>(s.seqs.size()) || t < 2 ||
+        t >= static_cast<int>(s.seqs[static_cast<size_t>(si)].d->lr_frames.size()))
+      gdsr::fail(path, "training state names a frame the data given does not have");
+  std::istringstream in(s.p.order_rng);
+  in >> s.rng;
+  if (!in) gdsr::fail(path, "training state: the frame-order RNG state does not parse");
+  s.noise.set_state(s.p.noise);
+}
+
 // Sequences, model, AdamW (resumed from opt.resume), VGG, the step range and the RNGs.
 void start_training(TrainState& s, const std::vector<const Dataset*>& data, const TrainOptions& opt) {
-  if (data.empty()) gdsr::fail("train", "no dataset given");
   for (const Dataset* d : data) {
-    if (d->lr_frames.size() < 3) gdsr::fail("train", "a dataset needs at least 3 frames");
     s.seqs.push_back(prepare(*d, opt));
     for (int t = 2; t < static_cast<int>(d->lr_frames.size()); ++t)
       s.frames.push_back({static_cast<int>(s.seqs.size()) - 1, t});
   }
+  for (const Dataset* d : opt.validation) s.val.push_back(prepare(*d, opt));
   s.model = std::make_unique<GDSR<float>>(opt.model);
   nn::AdamWOptions ao;
   ao.lr = opt.lr;
   ao.weight_decay = opt.weight_decay;
   ao.amsgrad = opt.amsgrad;
   s.adam = std::make_unique<nn::AdamW<float>>(s.model->named_parameters(), ao);
-  if (!opt.resume.empty()) s.step = nn::load_checkpoint(opt.resume, *s.model, s.adam.get()).step;
+  s.p.frames_per_step = opt.frames_per_step * opt.ranks;
+  s.p.frames_per_epoch = static_cast<int64_t>(s.frames.size());
+  s.rng.seed(opt.seed);
+  s.noise = nn::Rng(opt.seed * 7919 + 1);
+  if (!opt.resume.empty()) {
+    const nn::Checkpoint ck = nn::load_checkpoint(opt.resume, *s.model, s.adam.get());
+    restore_progress(s, ck, opt.resume, opt);
+    s.last_good = opt.resume;
+  }
+
+  const int64_t frames = s.p.frames_per_epoch * opt.epochs, per_step = int64_t{opt.frames_per_step} * opt.ranks;
+  if (frames < per_step)
+    gdsr::fail("train", std::to_string(opt.epochs) + " epoch(s) of " + std::to_string(s.p.frames_per_epoch) +
+                            " frames hold fewer frames than one step of " + std::to_string(per_step));
+  s.total = frames / per_step;
+  if (opt.max_steps > 0) s.total = std::min(s.total, opt.max_steps);
+  if (s.p.step >= s.total)
+    gdsr::fail(opt.resume, "is already at step " + std::to_string(s.p.step) + " of " + std::to_string(s.total) +
+                               "; raise --epochs or --max-steps to train further");
 
   if (opt.fine && opt.vgg && opt.loss.f_vgg.on && opt.loss.f_normal_map.on) {
     s.vgg = opt.vgg_dir.empty() ? std::make_unique<nn::VGG19Features<float>>()
@@ -97,122 +144,348 @@ void start_training(TrainState& s, const std::vector<const Dataset*>& data, cons
       return nn::vgg_loss(*vgg, pred, target);
     };
   }
-  s.per_epoch = static_cast<int64_t>(s.frames.size());
-  s.total = s.per_epoch * opt.epochs;
-  if (opt.max_steps >= 0) s.total = std::min(s.total, s.step + opt.max_steps);
-  s.rng.seed(opt.seed + static_cast<uint64_t>(s.step));
-  s.noise = nn::Rng(opt.seed * 7919 + 1 + static_cast<uint64_t>(s.step));
-  s.params = s.model->parameters();
+  s.named = s.model->named_parameters();
   s.res.parameters = s.model->num_parameters();
-  s.first_step = s.step;
+  s.first_step = s.p.step;
   s.start = std::chrono::steady_clock::now();
 }
 
-// Closes the epoch statistics (first and last epoch means).
+// Closes the epoch statistics (first and last epoch means of this process).
 void close_epoch(TrainState& s) {
-  if (s.current_epoch < 0 || s.epoch_count == 0) return;
+  if (s.stat_epoch < 0 || s.epoch_count == 0) return;
   const double mean = s.epoch_sum / static_cast<double>(s.epoch_count);
-  if (s.current_epoch == static_cast<int>(s.first_step / s.per_epoch)) s.res.first_epoch_mean = mean;
+  if (!s.first_epoch_closed) s.res.first_epoch_mean = mean;
+  s.first_epoch_closed = true;
   s.res.last_epoch_mean = mean;
 }
 
-// The (sequence, t) of this step; a new epoch reshuffles the frames.
+// The next training frame (sequence, t); a new epoch reshuffles the frames.
 std::pair<int, int> next_frame(TrainState& s) {
-  const int epoch = static_cast<int>(s.step / s.per_epoch);
-  if (epoch != s.current_epoch) {
-    close_epoch(s);
-    s.epoch_sum = 0;
-    s.epoch_count = 0;
-    s.current_epoch = epoch;
-    s.order = s.frames;
-    std::shuffle(s.order.begin(), s.order.end(), s.rng);
+  const int epoch = static_cast<int>(s.p.frame_pos / s.p.frames_per_epoch);
+  if (epoch != s.p.epoch) {
+    s.p.epoch = epoch;
+    s.p.order = s.frames;
+    std::shuffle(s.p.order.begin(), s.p.order.end(), s.rng);
   }
-  return s.order[static_cast<size_t>(s.step % s.per_epoch)];
+  return s.p.order[static_cast<size_t>(s.p.frame_pos++ % s.p.frames_per_epoch)];
 }
 
 std::string last_good(const TrainState& s) {
-  return s.res.checkpoint.empty() ? "" : "; last good checkpoint: " + s.res.checkpoint;
+  return s.last_good.empty() ? "" : "; last good checkpoint: " + s.last_good;
 }
 
-// One step on frame t of sequence si: forward, losses, finite checks, backward, AdamW.
-// Throws before the parameters are touched when the loss or a gradient is not finite.
-TrainLog train_step(TrainState& s, int si, int t, const TrainOptions& opt) {
-  Sequence& seq = s.seqs[static_cast<size_t>(si)];
-  const Dataset& d = *seq.d;
-  const auto t0 = std::chrono::steady_clock::now();
+struct FrameLoss {
+  ag::Tensorf total;
+  double coarse = 0, fine = 0;          // weighted parts
+  std::map<std::string, double> terms;  // unweighted
+};
 
+// Forward and losses of frame t of a sequence (noise and rng: training draws; nullptr noise
+// for validation).
+FrameLoss frame_loss(TrainState& s, Sequence& seq, int t, const Lambdas& lambdas, std::mt19937_64& rng,
+                     nn::Rng* noise, const TrainOptions& opt) {
+  const Dataset& d = *seq.d;
   const FrameInput in = make_frame_input(d, t, seq.lr_truth[t - 1], seq.lr_truth[t - 2], seq.body.get());
   PatchBatch batch;
   HrRequest request;
   if (opt.fine) {
-    batch = seq.sampler->sample(s.rng);
+    batch = seq.sampler->sample(rng);
     request = hr_request_subset(d.corr, batch.vertices);
   }
-  const Lambdas lambdas = opt.loss.schedule ? lambda_schedule(opt.loss, s.current_epoch) : Lambdas{1, 1};
-  const nn::StepDecay decay{opt.lr, 0.5, opt.lr_halve_every, opt.lr_floor};
-  decay.apply(*s.adam, s.step);
-
-  const GdsrOutput<float> out = s.model->forward(seq.graph, in, opt.fine ? &request : nullptr, &s.noise);
+  const GdsrOutput<float> out = s.model->forward(seq.graph, in, opt.fine ? &request : nullptr, noise);
   const CoarseLoss<float> coarse = coarse_loss(opt.loss, seq.lr_topo, out.C_hat, seq.lr_truth[t]);
   FineLoss<float> fine;
   if (opt.fine) fine = fine_loss(opt.loss, batch, out.G, d.hr_frames[t], s.image_loss);
-  const ag::Tensorf loss = total_loss(lambdas, coarse.total, fine.total);
+  FrameLoss f;
+  f.total = total_loss(lambdas, coarse.total, fine.total);
+  f.coarse = lambdas.coarse * coarse.total.item();
+  f.fine = fine.total.defined() ? lambdas.fine * fine.total.item() : 0.0;
+  f.terms = coarse.log();                   // keys c_position, c_normal, ...
+  if (opt.fine) f.terms.merge(fine.log());  // f_position, f_vgg, ...
+  return f;
+}
+
+std::string value_text(double v) {
+  if (std::isnan(v)) return "NaN";
+  if (std::isinf(v)) return v > 0 ? "+inf" : "-inf";
+  return std::to_string(v);
+}
+
+// Names the first non-finite loss term (then the weighted total) of a frame.
+void check_finite_loss(const TrainState& s, const FrameLoss& f, int si, int t) {
+  const std::string at = "training stopped at step " + std::to_string(s.p.step + 1);
+  const std::string frame = " (dataset " + std::to_string(si) + " frame " + std::to_string(t) + ")";
+  for (const auto& [name, v] : f.terms)
+    if (!std::isfinite(v))
+      gdsr::fail(at, "loss term " + name + " is " + value_text(v) + frame + last_good(s));
+  const double total = f.total.item();
+  if (!std::isfinite(total))
+    gdsr::fail(at, "the weighted loss total is " + value_text(total) + frame + last_good(s));
+}
+
+// L2 norm of all gradients; throws naming the first parameter with a non-finite gradient.
+double checked_grad_norm(const TrainState& s) {
+  double sum = 0;
+  for (const auto& [name, p] : s.named)
+    for (float g : p.grad()) {
+      if (!std::isfinite(g))
+        gdsr::fail("training stopped at step " + std::to_string(s.p.step + 1),
+                   "the gradient of parameter " + name + " is not finite" + last_good(s));
+      sum += static_cast<double>(g) * g;
+    }
+  return std::sqrt(sum);
+}
+
+// The gradients of a step's frames summed in double, frame by frame (each frame's float
+// gradient computed from zero), then over the ranks: one process with K frames per step and
+// K ranks with one frame each add the same float gradients in the same pairs.
+struct GradientSum {
+  std::vector<std::vector<double>> g;  // per parameter; empty: no gradient yet
+  explicit GradientSum(size_t n) : g(n) {}
+  // Moves the parameters' gradients of one frame into the sum.
+  void take(const TrainState& s) {
+    for (size_t i = 0; i < s.named.size(); ++i) {
+      auto& p = s.named[i].second;
+      if (!p.has_grad()) continue;
+      if (g[i].empty()) g[i].assign(static_cast<size_t>(p.numel()), 0.0);
+      const auto& pg = p.grad();
+      for (size_t k = 0; k < pg.size(); ++k) g[i][k] += pg[k];
+      p.node().zero_grad();
+    }
+  }
+  // Writes the sum back as the parameters' gradients.
+  void give(const TrainState& s) const {
+    for (size_t i = 0; i < s.named.size(); ++i) {
+      auto& grad = s.named[i].second.node().grad;
+      grad.assign(g[i].begin(), g[i].end());
+    }
+  }
+};
+
+// Sums the step's log figures and gradients over the ranks; a parameter without a gradient
+// on every rank keeps none, as in one process. Then checks the summed loss terms.
+void reduce_over_ranks(TrainState& s, TrainLog& L, GradientSum& sum, const TrainOptions& opt) {
+  std::vector<double> buf = {L.loss, L.coarse, L.fine};
+  for (const auto& [name, v] : L.terms) buf.push_back(v);
+  for (size_t i = 0; i < s.named.size(); ++i) {
+    buf.push_back(sum.g[i].empty() ? 0.0 : 1.0);
+    if (sum.g[i].empty())
+      buf.insert(buf.end(), static_cast<size_t>(s.named[i].second.numel()), 0.0);
+    else
+      buf.insert(buf.end(), sum.g[i].begin(), sum.g[i].end());
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  opt.allreduce_sum(buf);
+  L.allreduce_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  size_t j = 0;
+  L.loss = buf[j++];
+  L.coarse = buf[j++];
+  L.fine = buf[j++];
+  for (auto& [name, v] : L.terms) v = buf[j++];
+  for (size_t i = 0; i < s.named.size(); ++i) {
+    const bool any = buf[j++] > 0;
+    const size_t n = static_cast<size_t>(s.named[i].second.numel());
+    if (any)
+      sum.g[i].assign(buf.begin() + static_cast<std::ptrdiff_t>(j), buf.begin() + static_cast<std::ptrdiff_t>(j + n));
+    else
+      sum.g[i].clear();
+    j += n;
+  }
+  const std::string at = "training stopped at step " + std::to_string(s.p.step + 1);
+  for (const auto& [name, v] : L.terms)
+    if (!std::isfinite(v)) gdsr::fail(at, "loss term " + name + " is " + value_text(v) + " on a rank" + last_good(s));
+  if (!std::isfinite(L.loss)) gdsr::fail(at, "the weighted loss total is " + value_text(L.loss) + last_good(s));
+}
+
+// One optimizer step on the next frames_per_step x ranks frames (this rank takes every
+// ranks-th one): forward, losses, finite checks, backward, the gradient sum, AdamW. Every
+// frame draws one seed from each main RNG stream for its patches and noise whichever rank
+// computes it, so the streams do not depend on the number of ranks. Throws before the
+// parameters are touched when a loss term or a gradient is not finite.
+TrainLog train_step(TrainState& s, const TrainOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const nn::StepDecay decay{opt.lr, 0.5, opt.lr_halve_every, opt.lr_floor};
+  decay.apply(*s.adam, s.p.step);
+  s.adam->zero_grad();
 
   TrainLog L;
-  L.step = s.step + 1;
+  const int K = opt.frames_per_step * opt.ranks;
+  const double inv = 1.0 / K;
+  GradientSum sum(K > 1 ? s.named.size() : 0);  // one frame: its gradient stays in place
+  for (int k = 0; k < K; ++k) {
+    const auto [si, t] = next_frame(s);
+    if (k == 0) L.epoch = s.p.epoch;
+    const Lambdas lambdas = opt.loss.schedule ? lambda_schedule(opt.loss, L.epoch) : Lambdas{1, 1};
+    L.lambda_c = lambdas.coarse;
+    L.lambda_w = lambdas.fine;
+    std::mt19937_64 patch_rng(s.rng());
+    nn::Rng noise(s.noise.next());
+    if (k % opt.ranks != opt.rank) continue;
+    FrameLoss f = frame_loss(s, s.seqs[static_cast<size_t>(si)], t, lambdas, patch_rng, &noise, opt);
+    check_finite_loss(s, f, si, t);
+    L.loss += inv * f.total.item();
+    L.coarse += inv * f.coarse;
+    L.fine += inv * f.fine;
+    for (const auto& [name, v] : f.terms) L.terms[name] += inv * v;
+    if (K == 1) {
+      f.total.backward();
+    } else {
+      (f.total * static_cast<float>(inv)).backward();
+      sum.take(s);
+    }
+  }
+  if (opt.ranks > 1) reduce_over_ranks(s, L, sum, opt);
+  if (K > 1) sum.give(s);
+  L.step = s.p.step + 1;
   L.total_steps = s.total;
-  L.epoch = s.current_epoch;
-  L.loss = loss.item();
-  L.coarse = lambdas.coarse * coarse.total.item();
-  L.fine = fine.total.defined() ? lambdas.fine * fine.total.item() : 0.0;
-  L.lambda_c = lambdas.coarse;
-  L.lambda_w = lambdas.fine;
   L.lr = s.adam->lr();
-  L.terms = coarse.log();                   // keys c_position, c_normal, ...
-  if (opt.fine) L.terms.merge(fine.log());  // f_position, f_vgg, ...
-
-  const std::string at = "training stopped at step " + std::to_string(s.step + 1);
-  if (!std::isfinite(L.loss))
-    gdsr::fail(at, "the loss is " + std::to_string(L.loss) + " (coarse " + std::to_string(L.coarse) + ", fine " +
-                       std::to_string(L.fine) + ")" + last_good(s));
-  s.adam->zero_grad();
-  loss.backward();
-  if (!finite_gradients(s.params)) gdsr::fail(at, "a gradient is not finite" + last_good(s));
+  L.grad_norm = checked_grad_norm(s);
   s.adam->step();
   L.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return L;
 }
 
 void record_step(TrainState& s, const TrainLog& L) {
-  ++s.step;
+  ++s.p.step;
   if (s.res.steps == 0) s.res.first_loss = L.loss;
   s.res.last_loss = L.loss;
   ++s.res.steps;
+  if (L.epoch != s.stat_epoch) {
+    close_epoch(s);
+    s.epoch_sum = 0;
+    s.epoch_count = 0;
+    s.stat_epoch = L.epoch;
+  }
   s.epoch_sum += L.loss;
   ++s.epoch_count;
+  s.p.interval_sum += L.loss;
+  ++s.p.interval_count;
 }
 
-void save_checkpoint(TrainState& s, const TrainOptions& opt) {
-  if (opt.checkpoint.empty()) return;
-  nn::save_checkpoint(opt.checkpoint, *s.model, s.adam.get(), s.step, checkpoint_metadata(opt.model));
-  s.res.checkpoint = opt.checkpoint;
+// Mean losses over every validation frame: no gradient, no noise, patches from a fixed seed
+// (the same patches at every validation).
+void validate(TrainState& s, TrainLog& L, const TrainOptions& opt) {
+  if (s.val.empty()) return;
+  ag::NoGradGuard no_grad;
+  std::mt19937_64 rng(opt.seed + 0x5eed);
+  const Lambdas lambdas = opt.loss.schedule ? lambda_schedule(opt.loss, L.epoch) : Lambdas{1, 1};
+  double total = 0, coarse = 0, fine = 0;
+  int n = 0;
+  for (Sequence& seq : s.val)
+    for (int t = 2; t < static_cast<int>(seq.d->lr_frames.size()); ++t, ++n) {
+      const FrameLoss f = frame_loss(s, seq, t, lambdas, rng, nullptr, opt);
+      total += f.total.item();
+      coarse += f.coarse;
+      fine += f.fine;
+    }
+  L.validated = true;
+  L.val_loss = total / n;
+  L.val_coarse = coarse / n;
+  L.val_fine = fine / n;
+}
+
+void check_finite_parameters(const TrainState& s) {
+  for (const auto& [name, p] : s.named)
+    for (float v : p.values())
+      if (!std::isfinite(v))
+        gdsr::fail("training stopped at step " + std::to_string(s.p.step),
+                   "parameter " + name + " is not finite; not saved" + last_good(s));
+}
+
+void write_state(TrainState& s, const std::string& path, const TrainOptions& opt) {
+  std::ostringstream rng;
+  rng << s.rng;
+  s.p.order_rng = rng.str();
+  s.p.noise = s.noise.state();
+  nlohmann::json meta = nlohmann::json::parse(checkpoint_metadata(opt.model));
+  meta["trainer"] = progress_to_json(s.p);
+  nn::save_checkpoint(path, *s.model, s.adam.get(), s.p.step, meta.dump());
+}
+
+// Before a checkpoint: the finite check, the validation figures and whether this one is the
+// best so far (its figure the lowest yet).
+bool prepare_checkpoint(TrainState& s, TrainLog& L, const TrainOptions& opt) {
+  check_finite_parameters(s);
+  validate(s, L, opt);
+  const double figure =
+      L.validated ? L.val_loss : s.p.interval_sum / static_cast<double>(std::max<int64_t>(1, s.p.interval_count));
+  const bool best = !opt.best_checkpoint.empty() && std::isfinite(figure) && (!s.p.has_best || figure < s.p.best);
+  if (best) {
+    s.p.has_best = true;
+    s.p.best = figure;
+    s.res.best = figure;
+  }
+  s.p.interval_sum = 0;
+  s.p.interval_count = 0;
+  L.checkpointed = true;
+  return best;
+}
+
+// The last good checkpoint and, when `best`, the best one.
+void write_checkpoints(TrainState& s, bool best, const TrainOptions& opt) {
+  if (best) {
+    write_state(s, opt.best_checkpoint, opt);
+    s.res.best_checkpoint = opt.best_checkpoint;
+  }
+  if (!opt.checkpoint.empty()) {
+    write_state(s, opt.checkpoint, opt);
+    s.res.checkpoint = opt.checkpoint;
+    s.last_good = opt.checkpoint;
+  }
 }
 
 }  // namespace
 
+void validate_train_options(const TrainOptions& opt) {
+  if (opt.epochs <= 0) gdsr::fail("train", "--epochs must be positive, got " + std::to_string(opt.epochs));
+  if (opt.max_steps == 0 || opt.max_steps < -1)
+    gdsr::fail("train", "--max-steps must be positive, got " + std::to_string(opt.max_steps));
+  if (opt.ranks <= 0 || opt.rank < 0 || opt.rank >= opt.ranks)
+    gdsr::fail("train", "rank " + std::to_string(opt.rank) + " of " + std::to_string(opt.ranks) + " is not valid");
+  if (opt.ranks > 1 && !opt.allreduce_sum) gdsr::fail("train", "several ranks need an all-reduce");
+  if (opt.frames_per_step <= 0)
+    gdsr::fail("train", "--frames-per-step must be positive, got " + std::to_string(opt.frames_per_step));
+  if (!std::isfinite(opt.lr) || opt.lr <= 0) gdsr::fail("train", "--lr must be finite and > 0, got " + std::to_string(opt.lr));
+  if (!std::isfinite(opt.lr_floor) || opt.lr_floor < 0) gdsr::fail("train", "the lr floor must be finite and >= 0");
+  if (opt.lr_halve_every <= 0)
+    gdsr::fail("train", "--lr-halve-every must be positive, got " + std::to_string(opt.lr_halve_every));
+  if (!std::isfinite(opt.weight_decay) || opt.weight_decay < 0)
+    gdsr::fail("train", "the weight decay must be finite and >= 0");
+  if (opt.checkpoint_every < 0)
+    gdsr::fail("train", "--checkpoint-every must be >= 0, got " + std::to_string(opt.checkpoint_every));
+  if (opt.fine && (opt.patches.count <= 0 || opt.patches.size <= 0))
+    gdsr::fail("train", "--patches and --patch-size must be positive");
+  const LossConfig& c = opt.loss;
+  const std::pair<const char*, const LossTerm*> terms[] = {
+      {"c_position", &c.c_position}, {"c_normal", &c.c_normal},         {"c_strain", &c.c_strain},
+      {"c_smooth", &c.c_smooth},     {"c_dihedral", &c.c_dihedral},     {"f_position", &c.f_position},
+      {"f_normal_map", &c.f_normal_map}, {"f_vgg", &c.f_vgg},           {"f_image_l1", &c.f_image_l1},
+      {"f_strain", &c.f_strain},     {"f_smooth", &c.f_smooth}};
+  for (const auto& [name, term] : terms) check_weight(name, term->weight);
+  for (const auto& [name, w] : {std::pair<const char*, double>{"lambda_c_start", c.lambda_c_start},
+                                {"lambda_w_start", c.lambda_w_start}, {"lambda_c_end", c.lambda_c_end},
+                                {"lambda_w_end", c.lambda_w_end}, {"lambda_step", c.lambda_step}})
+    check_weight(name, w);
+}
+
 TrainResult train_gdsr(const std::vector<const Dataset*>& data, const TrainOptions& opt,
                        const std::function<void(const TrainLog&)>& log) {
+  validate_train_options(opt);
+  if (data.empty()) gdsr::fail("train", "no dataset given");
   TrainState s;
   start_training(s, data, opt);
-  while (s.step < s.total) {
-    const auto [si, t] = next_frame(s);
-    const TrainLog L = train_step(s, si, t, opt);
+  while (s.p.step < s.total) {
+    TrainLog L = train_step(s, opt);
     record_step(s, L);
+    // The log sees a step before its checkpoint does: a kill in between leaves a log that
+    // runs ahead of the checkpoint (the resumed run drops those rows), never one with a gap.
+    const bool save = (!opt.checkpoint.empty() || !opt.best_checkpoint.empty()) &&
+                      (s.p.step == s.total || (opt.checkpoint_every > 0 && s.p.step % opt.checkpoint_every == 0));
+    const bool best = save && prepare_checkpoint(s, L, opt);
     if (log) log(L);
-    if (opt.checkpoint_every > 0 && s.step % opt.checkpoint_every == 0) save_checkpoint(s, opt);
+    if (save) write_checkpoints(s, best, opt);
   }
   close_epoch(s);
-  save_checkpoint(s, opt);
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - s.start).count();
   s.res.seconds_per_step = s.res.steps ? secs / static_cast<double>(s.res.steps) : 0.0;
   return s.res;

@@ -3,8 +3,13 @@
 // corrected LR garment and the patch-based fine loss on the HR vertices under a batch of UV
 // patches (A is evaluated only on the LR triangles those patches need). AdamW with the
 // reference settings, lr step decay, the lambda schedule, periodic atomic checkpoints.
-// A non-finite loss or gradient stops training with an exception before the parameters
-// are touched, so the last checkpoint on disk is the last good one.
+// With frames_per_step K the gradients of K frames (each loss scaled by 1/K) are summed
+// before one optimizer step.
+// A non-finite loss term or gradient stops training with an exception naming the term (or
+// parameter) and the step before the parameters are touched, and parameters are checked
+// before every save, so the last checkpoint on disk is the last good one.
+// Checkpoints hold everything a run carries (train/train_state.hpp): resuming from one
+// continues bit-identically to a run that was never stopped.
 #pragma once
 
 #include "gdsr/data/dataset.hpp"
@@ -23,8 +28,10 @@ struct TrainOptions {
   ModelConfig model;
   LossConfig loss;
   PatchConfig patches;
-  int epochs = 1;          // passes over all training frames (t >= 2) of all datasets
-  int64_t max_steps = -1;  // stop earlier after this many steps (< 0: no limit)
+  int epochs = 1;          // passes over all training frames (t >= 2) of all datasets, > 0
+  int64_t max_steps = -1;  // stop when the run (counted from its start, resumes included)
+                           // reaches this many steps; -1: no limit, otherwise > 0
+  int frames_per_step = 1; // K frames' gradients averaged per optimizer step, > 0
   double lr = 1e-4;        // AdamW, reference settings
   double weight_decay = 0.01;
   bool amsgrad = true;
@@ -34,10 +41,25 @@ struct TrainOptions {
   bool vgg = true;         // VGG feature term of the fine loss
   std::string vgg_dir;     // empty: ../shared/weights/vgg19-imagenet-conv1-conv3
   uint64_t seed = 1;       // frame order, patches, noise
-  std::string checkpoint;  // written every checkpoint_every steps and at the end ("" = never)
+  std::string checkpoint;  // the last good state: every checkpoint_every steps and at the end ("" = never)
   int64_t checkpoint_every = 100;
-  std::string resume;  // continue from this checkpoint (model + optimizer + step)
+  // The best state so far ("" = never): written at a checkpoint whose figure is the lowest
+  // yet: the validation total when validation data is given, else the mean training total
+  // since the previous checkpoint.
+  std::string best_checkpoint;
+  std::vector<const Dataset*> validation;  // scored (no gradient) at every checkpoint
+  std::string resume;  // continue from this checkpoint (model, AdamW, data order, RNGs)
+  // Data-parallel training (train/mpi_ranks.hpp): this process is rank `rank` of `ranks`;
+  // a step covers frames_per_step frames on every rank, `allreduce_sum` sums a buffer over
+  // all ranks in place (needed when ranks > 1). Give checkpoint paths on one rank only.
+  int rank = 0, ranks = 1;
+  std::function<void(std::vector<double>&)> allreduce_sum;
 };
+
+// Throws a one-line gdsr::Error naming the option when a value is out of range (epochs,
+// max_steps, frames_per_step, lr, weight decay, schedule, loss weights, patches).
+// train_gdsr calls it first, so nothing is written for bad options.
+void validate_train_options(const TrainOptions& opt);
 
 struct TrainLog {
   int64_t step = 0, total_steps = 0;
@@ -45,7 +67,12 @@ struct TrainLog {
   double loss = 0, coarse = 0, fine = 0;  // total and the two weighted parts
   double lambda_c = 1, lambda_w = 1, lr = 0;
   double seconds = 0;                   // wall time of this step
-  std::map<std::string, double> terms;  // unweighted loss terms
+  double grad_norm = 0;                 // L2 norm of the (averaged) gradient of all parameters
+  double allreduce_seconds = 0;         // wall time of the sum over ranks (0 with one rank)
+  std::map<std::string, double> terms;  // unweighted loss terms (means over the step's frames)
+  bool checkpointed = false;            // a checkpoint was written after this step
+  bool validated = false;               // val_* hold the validation figures of this step
+  double val_loss = 0, val_coarse = 0, val_fine = 0;  // means over the validation frames
 };
 
 struct TrainResult {
@@ -54,7 +81,8 @@ struct TrainResult {
   double first_epoch_mean = 0, last_epoch_mean = 0;  // mean total over the first / last epoch
   double seconds_per_step = 0;
   int64_t parameters = 0;
-  std::string checkpoint;
+  std::string checkpoint, best_checkpoint;  // "" when not written
+  double best = 0;                           // the figure of the best checkpoint
 };
 
 TrainResult train_gdsr(const std::vector<const Dataset*>& data, const TrainOptions& opt,

@@ -19,7 +19,11 @@ namespace {
 
 RTCDevice shared_device() {
   static RTCDevice dev = [] {
-    RTCDevice d = rtcNewDevice(nullptr);
+    // One build thread: a BVH built by several threads differs from run to run and so did
+    // the body features (measured: training steps not reproducible between processes, which
+    // breaks an exact resume). Body meshes are small (a few thousand triangles); queries still
+    // run in parallel under OpenMP.
+    RTCDevice d = rtcNewDevice("threads=1");
     if (!d) gdsr::fail("BodyQuery", "cannot create an Embree device");
     return d;
   }();

@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include "tests/support/data_fixtures.hpp"
+#include "tests/support/train_options.hpp"
 #include "gdsr/geometry/correspondence.hpp"
 #include "gdsr/model/gdsr_model.hpp"
 #include "gdsr/model/model_checkpoint.hpp"
@@ -14,25 +15,12 @@
 #include <filesystem>
 #include <map>
 
-namespace {
-
-gdsr::TrainOptions tiny_options() {
-  gdsr::TrainOptions o;
-  o.model = gdsr::load_model_config(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json");
-  o.patches.size = 32;
-  o.patches.count = 2;
-  o.vgg = false;
-  o.lr = 3e-3;
-  o.loss.schedule = false;
-  return o;
-}
-
-}  // namespace
+const auto tiny_train_options = gdsr_test::tiny_train_options<gdsr::TrainOptions>;
 
 TEST_CASE("trainer: the loss of a tiny model falls on a waving sheet, checkpoints reload") {
   const gdsr::Dataset d = gdsr_test::wave_dataset();
   gdsr_test::TempDir dir("trainer");
-  gdsr::TrainOptions o = tiny_options();
+  gdsr::TrainOptions o = tiny_train_options();
   o.epochs = 60;  // 6 frames (t >= 2) per epoch
   o.checkpoint = dir / "model.ckpt";
   o.checkpoint_every = 50;
@@ -65,10 +53,10 @@ TEST_CASE("trainer: the loss of a tiny model falls on a waving sheet, checkpoint
   CHECK(nn::load_checkpoint<float>(o.checkpoint, model, nullptr).step == 360);
 }
 
-TEST_CASE("trainer: a non-finite loss stops training with a message and keeps the last checkpoint") {
+TEST_CASE("trainer: a NaN loss weight is refused and the last checkpoint kept") {
   const gdsr::Dataset d = gdsr_test::wave_dataset(5);
   gdsr_test::TempDir dir("trainer_nan");
-  gdsr::TrainOptions o = tiny_options();
+  gdsr::TrainOptions o = tiny_train_options();
   o.fine = false;
   o.checkpoint = dir / "model.ckpt";
   o.checkpoint_every = 1;
@@ -79,7 +67,8 @@ TEST_CASE("trainer: a non-finite loss stops training with a message and keeps th
   o.resume = o.checkpoint;
   o.max_steps = 5;
   o.loss.c_position.weight = std::nan("");
-  CHECK_THROWS_WITH_AS(gdsr::train_gdsr({&d}, o), doctest::Contains("training stopped at step 3"), std::runtime_error);
+  CHECK_THROWS_WITH_AS(gdsr::train_gdsr({&d}, o), doctest::Contains("loss weight c_position must be finite"),
+                       std::runtime_error);
   gdsr::GDSR<float> model(o.model);
   CHECK(nn::load_checkpoint<float>(o.checkpoint, model, nullptr).step == 2);  // the last good one
 }

@@ -1,0 +1,195 @@
+// `gdsr train` as a user runs it: a run killed with SIGKILL and resumed with --resume ends
+// bit-identical to an uninterrupted run; the run folder holds the CSV log, the loss curves
+// and the configuration; bad flags and files give a one-line error before anything is written.
+#include "nn/checkpoint.hpp"
+#include "tests/support/cli_run.hpp"
+#include "tests/support/data_fixtures.hpp"
+
+#include <doctest/doctest.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+#include <thread>
+#include <unistd.h>
+
+using gdsr_test::check_one_line_error;
+using gdsr_test::gdsr_run;
+using gdsr_test::Run;
+using gdsr_test::slurp;
+using gdsr_test::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kEpochs = 20;  // 6 frames per epoch: 120 steps
+
+std::string train_args(const std::string& data, const std::string& out) {
+  return "train --data '" + data + "' --config '" + GDSR_SOURCE_DIR + "/configs/tiny.json' --no-vgg --patches 2 " +
+         "--patch-size 32 --lr 3e-3 --epochs " + std::to_string(kEpochs) +
+         " --checkpoint-every 2 --log-every 0 --out '" + out + "'";
+}
+
+int64_t checkpoint_step(const std::string& path) {
+  try {
+    return nn::read_checkpoint(path).step;
+  } catch (const std::exception&) {
+    return -1;
+  }
+}
+
+// Data rows of a train_log.csv (header dropped).
+std::vector<std::string> csv_rows(const std::string& path) {
+  std::istringstream in(slurp(path));
+  std::vector<std::string> rows;
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) rows.push_back(line);
+  return rows;
+}
+
+std::string column(const std::string& row, int k) {
+  std::istringstream in(row);
+  std::string f;
+  for (int i = 0; i <= k; ++i) std::getline(in, f, ',');
+  return f;
+}
+
+}  // namespace
+
+TEST_CASE("cli train: kill -9 mid-run then --resume is bit-identical to an uninterrupted run") {
+  TempDir dir("cli_train_kill");
+  const std::string data = dir / "wave";
+  gdsr::write_dataset(data, gdsr_test::wave_dataset());
+  const int total = 6 * kEpochs;
+
+  const Run whole = gdsr_run(dir, train_args(data, dir / "whole"));
+  REQUIRE(whole.status == 0);
+  CHECK(checkpoint_step(dir / "whole/model.ckpt") == total);
+
+  // The same run in the background, killed with SIGKILL once it has checkpointed a few steps.
+  const std::string killed = dir / "killed";
+  const std::string cmd = std::string("exec '") + GDSR_BINARY_DIR + "/gdsr' " + train_args(data, killed) +
+                          " >'" + (dir / "k.out") + "' 2>'" + (dir / "k.err") + "'";
+  const pid_t pid = fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int64_t at = -1;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    at = checkpoint_step(killed + "/model.ckpt");
+    if (at >= 10) break;
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+  // Then a random moment later: inside a step, a checkpoint write or a log append.
+  std::this_thread::sleep_for(std::chrono::microseconds(std::random_device{}() % 30000));
+  kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  REQUIRE(WIFSIGNALED(status));  // killed, not finished
+  const int64_t kept = checkpoint_step(killed + "/model.ckpt");
+  MESSAGE("saw checkpoint step " << at << ", killed; checkpoint on disk: step " << kept << " of " << total);
+  REQUIRE(kept >= 10);
+  REQUIRE(kept < total);
+
+  const Run resumed = gdsr_run(dir, train_args(data, killed) + " --resume '" + killed + "/model.ckpt'");
+  REQUIRE(resumed.status == 0);
+  CHECK(resumed.out.find("trained " + std::to_string(total - kept) + " steps") != std::string::npos);
+  const nn::Checkpoint a = nn::read_checkpoint(dir / "whole/model.ckpt");
+  const nn::Checkpoint b = nn::read_checkpoint(killed + "/model.ckpt");
+  CHECK(b.step == total);
+  REQUIRE(a.entries.size() == b.entries.size());
+  int differ = 0;
+  for (size_t i = 0; i < a.entries.size(); ++i) differ += a.entries[i].bytes != b.entries[i].bytes;
+  CHECK(differ == 0);  // parameters and AdamW state, bit for bit
+
+  // The log of the resumed run has every step once, with the uninterrupted run's losses.
+  const std::vector<std::string> ra = csv_rows(dir / "whole/train_log.csv"), rb = csv_rows(killed + "/train_log.csv");
+  REQUIRE(static_cast<int>(ra.size()) == total);
+  REQUIRE(static_cast<int>(rb.size()) == total);
+  int losses_differ = 0;
+  for (int i = 0; i < total; ++i) {
+    CHECK(column(rb[static_cast<size_t>(i)], 0) == std::to_string(i + 1));
+    losses_differ += column(ra[static_cast<size_t>(i)], 2) != column(rb[static_cast<size_t>(i)], 2);
+  }
+  CHECK(losses_differ == 0);
+}
+
+TEST_CASE("cli train: the run folder holds the CSV log and loss curves and configuration") {
+  TempDir dir("cli_train_log");
+  const std::string data = dir / "wave";
+  gdsr::write_dataset(data, gdsr_test::wave_dataset());
+  const std::string out = dir / "run";
+  const Run r = gdsr_run(dir, "train --data '" + data + "' --val-data '" + data + "' --config '" + GDSR_SOURCE_DIR +
+                                  "/configs/tiny.json' --no-vgg --patches 2 --patch-size 32 --epochs 4 " +
+                                  "--frames-per-step 2 --checkpoint-every 3 --out '" + out + "'");
+  REQUIRE(r.status == 0);
+  const std::vector<std::string> rows = csv_rows(out + "/train_log.csv");
+  REQUIRE(rows.size() == 12);  // 24 frames, 2 per step
+  const std::string header = slurp(out + "/train_log.csv").substr(0, slurp(out + "/train_log.csv").find('\n'));
+  for (const char* c : {"c_position", "f_smooth", "lr", "lambda_c", "lambda_w", "grad_norm", "seconds", "val_loss"})
+    CHECK(header.find(c) != std::string::npos);
+  CHECK(!column(rows[2], 20).empty());  // step 3: a checkpoint, validated
+  CHECK(column(rows[3], 20).empty());
+  CHECK(std::stod(column(rows[0], 18)) > 0);  // gradient norm
+  CHECK(fs::file_size(out + "/loss_curves.png") > 5000);
+  CHECK(fs::exists(out + "/model.best.ckpt"));
+  const nlohmann::json cfg = nlohmann::json::parse(slurp(out + "/config.json"));
+  CHECK(cfg.at("frames_per_step") == 2);
+  CHECK(cfg.at("model").at("mp_steps") == 2);  // the preset's values, not its file name alone
+  CHECK(cfg.at("loss").at("coarse").at("smooth").at("weight") == 100.0);
+  CHECK(cfg.at("command").at("val_data").size() == 1);
+  fs::copy_file(out + "/loss_curves.png", fs::path(GDSR_BINARY_DIR) / "cli_train_loss_curves.png",
+                fs::copy_options::overwrite_existing);  // kept to look at
+}
+
+TEST_CASE("cli train: bad flags and files give a one-line error and write nothing") {
+  TempDir dir("cli_train_bad");
+  const std::string data = dir / "wave";
+  gdsr::write_dataset(data, gdsr_test::wave_dataset());
+  const std::string out = dir / "out";
+  const std::string base = "train --data '" + data + "' --config '" + GDSR_SOURCE_DIR +
+                           "/configs/tiny.json' --no-vgg --patches 2 --patch-size 32 --out '" + out + "'";
+  check_one_line_error(gdsr_run(dir, base + " --epochs 0"), "--epochs must be positive");
+  check_one_line_error(gdsr_run(dir, base + " --epochs -1"), "--epochs must be positive");
+  check_one_line_error(gdsr_run(dir, base + " --max-steps 0"), "--max-steps must be positive");
+  check_one_line_error(gdsr_run(dir, base + " --max-steps -1"), "--max-steps must be positive");
+  check_one_line_error(gdsr_run(dir, base + " --lr nan"), "--lr must be finite");
+  check_one_line_error(gdsr_run(dir, base + " --lr -1"), "--lr must be finite");
+  check_one_line_error(gdsr_run(dir, base + " --frames-per-step 0"), "--frames-per-step must be positive");
+  check_one_line_error(gdsr_run(dir, base + " --epochs x"), "--epochs");
+  {
+    std::ofstream(dir / "neg.json") << R"({"coarse": {"smooth": {"weight": -1}}})";
+    check_one_line_error(gdsr_run(dir, base + " --loss-config '" + (dir / "neg.json") + "'"), "weight");
+    nlohmann::json j = nlohmann::json::parse(slurp(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json"));
+    j["mp_stpes"] = 3;
+    std::ofstream(dir / "typo.json") << j.dump();
+    const std::string typo = "train --data '" + data + "' --config '" + (dir / "typo.json") + "' --out '" + out + "'";
+    check_one_line_error(gdsr_run(dir, typo), "mp_stpes");
+  }
+  CHECK_FALSE(fs::exists(out));
+
+  // A corrupt --resume names the file and leaves the run folder as it was.
+  REQUIRE(gdsr_run(dir, base + " --max-steps 2").status == 0);
+  const std::string log_before = slurp(out + "/train_log.csv");
+  std::string bytes = slurp(out + "/model.ckpt");
+  bytes[bytes.size() - 3] ^= 0x01;
+  std::ofstream(dir / "bad.ckpt", std::ios::binary) << bytes;
+  check_one_line_error(gdsr_run(dir, base + " --max-steps 4 --resume '" + (dir / "bad.ckpt") + "'"),
+                       "bad.ckpt': checksum mismatch");
+  CHECK(slurp(out + "/train_log.csv") == log_before);
+  CHECK(nn::read_checkpoint(out + "/model.ckpt").step == 2);
+
+  // A missing frame file of the dataset names the file.
+  for (const auto& e : fs::directory_iterator(data))
+    if (e.path().filename().string().find("hr_frames") != std::string::npos) fs::remove(e.path());
+  check_one_line_error(gdsr_run(dir, base + " --max-steps 4"), "hr_frames");
+  CHECK(nn::read_checkpoint(out + "/model.ckpt").step == 2);
+}
