@@ -3,6 +3,7 @@
 #pragma once
 
 #include "gdsr/data/dataset.hpp"
+#include "infer/prediction_io.hpp"
 #include "infer/rollout.hpp"
 
 #include <string>
@@ -26,5 +27,11 @@ gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d);
 
 // --data, --first, --frames, --no-collisions.
 void add_rollout_options(CLI::App* c, RolloutArgs& a);
+
+// --model (roll out now) or --pred (a folder written by gdsr infer): exactly one.
+void add_source_options(CLI::App* c, RolloutArgs& a);
+
+// The prediction of the chosen source: run_rollout for --model, read_prediction for --pred.
+gdsr::Prediction obtain_prediction(const RolloutArgs& a, const gdsr::Dataset& d);
 
 }  // namespace gdsr_cli

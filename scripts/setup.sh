@@ -6,7 +6,8 @@ cd "$(dirname "$0")/.."
 
 packages=(g++ cmake make libeigen3-dev libassimp-dev assimp-testmodels libembree-dev
           libopencv-dev doctest-dev libcli11-dev nlohmann-json3-dev libnanoflann-dev
-          libcgal-dev libbenchmark-dev)
+          libcgal-dev libbenchmark-dev
+          blender python3-numpy)  # the test that Blender opens the glTF / OBJ / PC2 exports
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

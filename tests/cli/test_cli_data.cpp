@@ -2,6 +2,7 @@
 // stderr and a non-zero exit status.
 #include "gdsr/geometry/mesh_ops.hpp"
 #include "gdsr/geometry/obj_io.hpp"
+#include "tests/support/cli_run.hpp"
 #include "tests/support/data_fixtures.hpp"
 
 #include <doctest/doctest.h>
@@ -12,53 +13,13 @@
 #include <sstream>
 #include <sys/wait.h>
 
+using gdsr_test::check_one_line_error;
+using gdsr_test::gdsr_run;
+using gdsr_test::Run;
 using gdsr_test::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct Run {
-  int status = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-Run gdsr_run(const TempDir& dir, const std::string& args) {
-  const std::string out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd = std::string("'") + GDSR_BINARY_DIR + "/gdsr' " + args + " >'" + out + "' 2>'" + err + "'";
-  const int rc = std::system(cmd.c_str());
-  Run r;
-  r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
-
-int count_lines(const std::string& s) {
-  int n = 0;
-  for (char c : s) n += c == '\n';
-  return n;
-}
-
-// Progress lines (stderr is not a terminal here) may precede the error; the error itself is
-// the last line, exactly one line.
-void check_one_line_error(const Run& r, const std::string& needle) {
-  CHECK(r.status == 1);
-  REQUIRE(!r.err.empty());
-  CHECK(r.err.back() == '\n');
-  const size_t start = r.err.rfind('\n', r.err.size() - 2);
-  const std::string last = r.err.substr(start == std::string::npos ? 0 : start + 1);
-  CHECK(last.rfind("gdsr: error: ", 0) == 0);
-  CHECK(count_lines(r.err.substr(r.err.find("gdsr: error: "))) == 1);
-  CHECK(last.find(needle) != std::string::npos);
-  if (last.find(needle) == std::string::npos) MESSAGE("stderr: " << r.err);
-}
 
 // MD-style exports of a small tube: LR/HR frame folders and flattened OBJs.
 void write_md_exports(const TempDir& dir, int lr_frames, int hr_frames) {
