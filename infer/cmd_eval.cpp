@@ -9,10 +9,12 @@
 #include "infer/evaluate.hpp"
 #include "infer/export_rollout.hpp"
 #include "infer/report.hpp"
+#include "infer/report_viewer.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 
@@ -22,7 +24,7 @@ struct EvalArgs : gdsr_cli::RolloutArgs {
   std::string report;
   std::vector<int> image_steps;
   int video_every = 1;
-  bool no_video = false, no_export = false;
+  bool no_video = false, no_export = false, no_viewer = false;
 };
 
 // The report folder: tables, plots, images, video and (unless --no-export) glTF + PC2
@@ -34,6 +36,21 @@ void write_report(const EvalArgs& a, const gdsr::Dataset& d, const gdsr::Predict
   ro.image_steps = a.image_steps;
   ro.video = !a.no_video;
   ro.video_every = a.video_every;
+  // The viewer needs the exports and three.js (npm, installed by scripts/setup.sh).
+  const char* env = std::getenv("GDSR_VIEWER_DIR");
+  const std::string viewer_src = env ? env : GDSR_VIEWER_DIR;
+  const bool three = fs::exists(fs::path(viewer_src) / "node_modules/three/build/three.module.js");
+  const bool viewer = !a.no_export && !a.no_viewer && three;
+  if (!a.no_export && !a.no_viewer && !three)
+    std::fprintf(stderr,
+                 "gdsr: note: no viewer in the report: three.js is not installed in %s (run scripts/setup.sh)\n",
+                 viewer_src.c_str());
+  if (viewer)
+    ro.extra_md.push_back(
+        "## Viewer\n\n`viewer/index.html` plays LR input | GDSR | HR simulation side by side in a browser (orbit "
+        "with the mouse, frame slider, normal-map toggle). Browsers load it over HTTP only: `python3 -m http.server "
+        "-d " +
+        a.report + " 8000`, then open http://localhost:8000/viewer/ (no network needed).\n");
   if (!a.no_export)
     ro.extra_md.push_back(
         "## Exports\n\n`export/`: the LR input (`lr`), the GDSR prediction (`gdsr`) and the HR simulation (`hr`) as "
@@ -47,8 +64,10 @@ void write_report(const EvalArgs& a, const gdsr::Dataset& d, const gdsr::Predict
     eo.formats.obj = false;
     gdsr::export_rollout((fs::path(a.report) / "export").string(), d, p.G, p.first_frame, eo);
   }
-  std::printf("wrote report %s: %zu files (report.md, report.json, plots/, images/%s%s)\n", a.report.c_str(),
-              files.size(), a.no_video ? "" : ", rollout.avi", a.no_export ? "" : ", export/");
+  if (viewer) gdsr::write_viewer(a.report, viewer_src);
+  std::printf("wrote report %s: %zu files (report.md, report.json, plots/, images/%s%s%s)\n", a.report.c_str(),
+              files.size(), a.no_video ? "" : ", rollout.avi", a.no_export ? "" : ", export/",
+              viewer ? ", viewer/" : "");
 }
 
 void print_evaluation(const gdsr::Evaluation& e) {
@@ -73,7 +92,8 @@ void add_eval_command(CLI::App& app) {
       ->delimiter(',');
   c->add_option("--video-every", a->video_every, "report video: every k-th frame")->capture_default_str();
   c->add_flag("--no-video", a->no_video, "report without the video");
-  c->add_flag("--no-export", a->no_export, "report without the glTF / PC2 exports");
+  c->add_flag("--no-export", a->no_export, "report without the glTF / PC2 exports (and the viewer)");
+  c->add_flag("--no-viewer", a->no_viewer, "report without the browser viewer");
   c->callback([a]() {
     if (a->video_every < 1) gdsr::fail("--video-every", "must be at least 1");
     const gdsr::Dataset d = gdsr::load_dataset(a->data);

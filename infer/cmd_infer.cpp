@@ -17,15 +17,7 @@ namespace {
 
 void write_prediction(const RolloutArgs& a, const gdsr::Dataset& d, const gdsr::RolloutResult& r) {
   namespace fs = std::filesystem;
-  gdsr::Prediction p;
-  p.first_frame = r.first_frame;
-  p.G = r.G;
-  p.C_hat = r.C_hat;
-  p.dataset = a.data;
-  p.model = a.model;
-  p.seconds_per_frame = r.seconds_per_frame;
-  p.model_seconds_per_frame = r.model_seconds_per_frame;
-  gdsr::write_prediction(a.out, p);
+  gdsr::write_prediction(a.out, gdsr_cli::to_prediction(a, r));
   if (a.obj_every > 0)
     for (size_t k = 0; k < r.G.size(); k += static_cast<size_t>(a.obj_every)) {
       gdsr::GarmentMesh m = d.hr;

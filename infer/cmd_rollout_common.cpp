@@ -38,7 +38,10 @@ void add_source_options(CLI::App* c, RolloutArgs& a) {
 
 gdsr::Prediction obtain_prediction(const RolloutArgs& a, const gdsr::Dataset& d) {
   if (a.model.empty()) return gdsr::read_prediction(a.pred, true);
-  gdsr::RolloutResult r = run_rollout(a, d);
+  return to_prediction(a, run_rollout(a, d));
+}
+
+gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r) {
   gdsr::Prediction p;
   p.first_frame = r.first_frame;
   p.G = std::move(r.G);

@@ -25,6 +25,9 @@ struct RolloutArgs {
 // Loads the checkpoint a.model, rolls it out over d with a progress bar, prints a summary.
 gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d);
 
+// The roll-out as a prediction (named after a.data and a.model).
+gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r);
+
 // --data, --first, --frames, --no-collisions.
 void add_rollout_options(CLI::App* c, RolloutArgs& a);
 

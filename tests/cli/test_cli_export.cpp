@@ -73,6 +73,11 @@ TEST_CASE("cli eval: --report writes tables plots images video and exports") {
                         "export/hr.pc2", "export/export.json"})
     CHECK_MESSAGE(fs::exists(dir / ("rep/" + std::string(f))), f);
   CHECK(gdsr_test::slurp(dir / "rep/report.md").find("## Exports") != std::string::npos);
+  // The viewer when three.js is installed (scripts/setup.sh), else a note saying why not.
+  const bool three = fs::exists(std::string(GDSR_SOURCE_DIR) + "/viewer/node_modules/three/build/three.module.js");
+  CHECK(fs::exists(dir / "rep/viewer/index.html") == three);
+  CHECK(fs::exists(dir / "rep/viewer/three/three.module.js") == three);
+  if (!three) CHECK(r.err.find("no viewer in the report") != std::string::npos);
   check_one_line_error(gdsr_run(dir, "eval --pred '" + (dir / "pred") + "' --data '" + (dir / "ds") + "' --report '" +
                                          (dir / "rep2") + "' --report-steps 9"),
                        "image step 9");

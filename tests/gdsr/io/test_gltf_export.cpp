@@ -3,6 +3,7 @@
 // positions at a few frames equal the exported frames, float32 rounding aside.
 #include <doctest/doctest.h>
 
+#include "gdsr/error.hpp"
 #include "gdsr/io/gltf_export.hpp"
 #include "tests/support/data_fixtures.hpp"
 #include "tests/support/grid_garment.hpp"
