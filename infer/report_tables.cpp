@@ -27,10 +27,10 @@ std::string num(double x, const char* fmt = "%.4f") {
 
 std::string step_name(int s) { return s == 1 ? "1-step" : "roll-" + std::to_string(s); }
 
-// A markdown table header: the first column left-aligned, the others right-aligned.
-std::string header(const std::vector<std::string>& cols) {
+// A markdown table header: the first `text` columns left-aligned, the numbers right-aligned.
+std::string header(const std::vector<std::string>& cols, size_t text = 1) {
   std::string h = "|", rule = "|";
-  for (size_t i = 0; i < cols.size(); ++i) h += " " + cols[i] + " |", rule += i == 0 ? "---|" : "---:|";
+  for (size_t i = 0; i < cols.size(); ++i) h += " " + cols[i] + " |", rule += i < text ? "---|" : "---:|";
   return h + "\n" + rule + "\n";
 }
 
@@ -60,7 +60,7 @@ std::string report_markdown(const Dataset& d, const Prediction& p, const Evaluat
   md += "## Table 2: stretching and shearing energies under roll-out\n\n";
   md +=
       "Mean over triangles of E_u = (|w_u| - 1)^2, E_v = (|w_v| - 1)^2, E_uv = (w_u . w_v)^2 (paper, appendix B).\n\n";
-  md += header(cols);
+  md += header(cols, 2);
   const char* names[3] = {"E_u", "E_v", "E_uv"};
   struct Row {
     const char* method;
