@@ -53,16 +53,24 @@ bool port_open(int port) {
   return ok;
 }
 
-// python3's http.server on 127.0.0.1:port serving dir, stopped (by its pid) on destruction.
+// python3's http.server on 127.0.0.1 serving dir, on a free port the system picks (read from
+// its log), stopped (by its pid) on destruction.
 struct HttpServer {
-  int pid = -1;
-  HttpServer(const std::string& dir, int port, const std::string& log) {
+  int pid = -1, port = -1;
+  HttpServer(const std::string& dir, const std::string& log) {
     const std::string pidfile = log + ".pid";
-    const std::string cmd = "python3 -m http.server " + std::to_string(port) + " --bind 127.0.0.1 -d '" + dir + "' >'" +
-                            log + "' 2>&1 & echo $! >'" + pidfile + "'";
+    const std::string cmd = "python3 -u -m http.server 0 --bind 127.0.0.1 -d '" + dir + "' >'" + log +
+                            "' 2>&1 & echo $! >'" + pidfile + "'";
     if (std::system(cmd.c_str()) != 0) return;
     pid = std::atoi(slurp(pidfile).c_str());
-    for (int i = 0; i < 100 && !port_open(port); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const std::string key = " port ";  // "Serving HTTP on 127.0.0.1 port 40123 (http://...) ..."
+    for (int i = 0; i < 200 && port < 0; ++i) {
+      const std::string text = slurp(log);
+      const size_t at = text.find(key);
+      if (at != std::string::npos && text.find(" (", at) != std::string::npos)
+        port = std::atoi(text.c_str() + at + key.size());
+      if (port < 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
   }
   ~HttpServer() {
     if (pid > 0) ::kill(pid, SIGTERM);
@@ -117,12 +125,12 @@ TEST_CASE("report viewer: headless Chromium loads the exports and shows three ga
   const auto files = gdsr::write_viewer(dir / "report", viewer_src);
   CHECK(files.size() == 6);
 
-  const int port = 20000 + ::getpid() % 20000;
   const std::string http_log = dir / "http.log";
-  HttpServer server(dir / "report", port, http_log);
+  HttpServer server(dir / "report", http_log);
   REQUIRE(server.pid > 0);
-  REQUIRE(port_open(port));
-  const std::string url = "http://127.0.0.1:" + std::to_string(port) + "/viewer/?frame=3";
+  REQUIRE(server.port > 0);
+  REQUIRE(port_open(server.port));
+  const std::string url = "http://127.0.0.1:" + std::to_string(server.port) + "/viewer/?frame=3";
   const std::string flags =
       " --headless --no-sandbox --disable-gpu --use-gl=swiftshader --enable-unsafe-swiftshader "
       "--virtual-time-budget=8000 --window-size=1200,600 ";
