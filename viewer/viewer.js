@@ -28,7 +28,8 @@ scene.add(sun);
 const camera = new THREE.PerspectiveCamera(35, window.innerWidth / window.innerHeight, 0.01, 100);
 const controls = new OrbitControls(camera, renderer.domElement);
 
-const meshes = [];  // { mesh, cloth, normal }
+const meshes = [];   // { mesh, cloth, normal }
+const garments = [];  // { root, slot: x offset, centroids: [Vector3 per frame] }
 let frames = 1, fps = 30, frame = 0, playing = true, last = performance.now();
 
 function setFrame(k) {
@@ -39,6 +40,8 @@ function setFrame(k) {
     w.fill(0);
     if (k > 0) w[k - 1] = 1;
   }
+  // Follow the garments: each one's centroid at frame k sits at its slot (the body may walk).
+  for (const g of garments) g.root.position.set(g.slot, 0, 0).sub(g.centroids[Math.min(k, g.centroids.length - 1)]);
   document.getElementById('frame').value = k;
   document.getElementById('frame_label').textContent = 'frame ' + k;
 }
@@ -52,14 +55,17 @@ async function main() {
   const loader = new GLTFLoader();
   const order = ['lr', 'gdsr', 'hr'].map((n) => info.sequences.find((s) => s.name === n)).filter((s) => s && s.gltf);
   const gltfs = await Promise.all(order.map((s) => loader.loadAsync('../export/' + s.gltf)));
-  const box = new THREE.Box3();
-  gltfs.forEach((g) => box.expandByObject(g.scene));
-  const size = box.getSize(new THREE.Vector3());
+  // Framing from frame 0 (the base shape; a box over all morph targets would span the walk).
+  const size = new THREE.Vector3();
+  for (const g of gltfs)
+    g.scene.traverse((o) => {
+      if (o.isMesh) size.max(new THREE.Box3().setFromBufferAttribute(o.geometry.attributes.position).getSize(new THREE.Vector3()));
+    });
   const step = Math.max(size.x, size.z) * 1.3;
   gltfs.forEach((g, i) => {
     const name = order[i].name;
-    g.scene.position.x = (i - (gltfs.length - 1) / 2) * step;
     scene.add(g.scene);
+    let centroids = [new THREE.Vector3()];
     g.scene.traverse((o) => {
       if (!o.isMesh) return;
       // flatShading: normals from the morphed positions (the files carry no normals).
@@ -69,19 +75,21 @@ async function main() {
       o.material = cloth;
       o.frustumCulled = false;  // the bounding box is the base frame's
       meshes.push({ mesh: o, cloth, normal });
+      centroids = frameCentroids(o.geometry);
     });
+    garments.push({ root: g.scene, slot: (i - (gltfs.length - 1) / 2) * step, centroids });
     const label = document.createElement('span');
     label.textContent = titles[name];
     document.getElementById('labels').append(label);
   });
-  const centre = box.getCenter(new THREE.Vector3());
   const span = step * gltfs.length;
   // Distance that fits the row horizontally and the tallest garment vertically.
   const tanHalf = Math.tan(THREE.MathUtils.degToRad(camera.fov / 2));
   const dist = 1.1 * Math.max(span / 2 / (tanHalf * camera.aspect), size.y / 2 / tanHalf) + size.z / 2;
-  camera.position.set(centre.x, centre.y, centre.z + dist);
-  controls.target.copy(centre);
+  camera.position.set(0, 0, dist);
+  controls.target.set(0, 0, 0);
   controls.update();
+  setFrame(0);
   const slider = document.getElementById('frame');
   slider.max = frames - 1;
   slider.addEventListener('input', () => { playing = false; setFrame(Number(slider.value)); updateButton(); });
@@ -94,6 +102,20 @@ async function main() {
   if (params.has('normals')) document.getElementById('normals').click();
   updateButton();
   status.textContent = `ready: ${gltfs.length} garments, ${frames} frames at ${fps} fps`;
+}
+
+// Centroid of every frame: the base positions, plus the mean of morph target k - 1 (glTF
+// targets are displacements) for frame k.
+function frameCentroids(geometry) {
+  const mean = (a) => {
+    const m = new THREE.Vector3();
+    for (let i = 0; i < a.length; i += 3) m.x += a[i], m.y += a[i + 1], m.z += a[i + 2];
+    return m.multiplyScalar(3 / a.length);
+  };
+  const base = mean(geometry.attributes.position.array);
+  const out = [base];
+  for (const t of geometry.morphAttributes.position || []) out.push(mean(t.array).add(base));
+  return out;
 }
 
 function updateButton() { document.getElementById('play').textContent = playing ? 'pause' : 'play'; }
