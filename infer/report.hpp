@@ -4,6 +4,7 @@
 //   plots/error.png, plots/ssim.png, plots/energies.png
 //   images/normals_SSSSS.png, images/shaded_SSSSS.png   LR | GDSR | HR at roll-out step S
 //   rollout.avi        MJPG video LR | GDSR | HR (report_media.hpp)
+// `gdsr eval` adds export/ (export_rollout.hpp) and viewer/ (report_viewer.hpp).
 #pragma once
 
 #include "gdsr/data/dataset.hpp"
