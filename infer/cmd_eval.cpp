@@ -7,18 +7,68 @@
 #include "gdsr/cli/progress_bar.hpp"
 #include "infer/cmd_rollout_common.hpp"
 #include "infer/evaluate.hpp"
+#include "infer/export_rollout.hpp"
+#include "infer/report.hpp"
+#include "infer/report_viewer.hpp"
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 
-using gdsr_cli::RolloutArgs;
-
 namespace {
+
+struct EvalArgs : gdsr_cli::RolloutArgs {
+  std::string report;
+  std::vector<int> image_steps;
+  int video_every = 1;
+  bool no_video = false, no_export = false, no_viewer = false;
+};
+
+// The report folder: tables, plots, images, video and (unless --no-export) glTF + PC2
+// exports of the three sequences in DIR/export.
+void write_report(const EvalArgs& a, const gdsr::Dataset& d, const gdsr::Prediction& p, const gdsr::Evaluation& e) {
+  namespace fs = std::filesystem;
+  gdsr::ReportOptions ro;
+  ro.dataset_path = a.data;
+  ro.image_steps = a.image_steps;
+  ro.video = !a.no_video;
+  ro.video_every = a.video_every;
+  // The viewer needs the exports and three.js (npm, installed by scripts/setup.sh).
+  const char* env = std::getenv("GDSR_VIEWER_DIR");
+  const std::string viewer_src = env ? env : GDSR_VIEWER_DIR;
+  const bool three = fs::exists(fs::path(viewer_src) / "node_modules/three/build/three.module.js");
+  const bool viewer = !a.no_export && !a.no_viewer && three;
+  if (!a.no_export && !a.no_viewer && !three)
+    std::fprintf(stderr,
+                 "gdsr: note: no viewer in the report: three.js is not installed in %s (run scripts/setup.sh)\n",
+                 viewer_src.c_str());
+  if (viewer)
+    ro.extra_md.push_back(
+        "## Viewer\n\n`viewer/index.html` plays LR input | GDSR | HR simulation side by side in a browser (orbit "
+        "with the mouse, frame slider, normal-map toggle). Browsers load it over HTTP only: `python3 -m http.server "
+        "-d " +
+        a.report + " 8000`, then open http://localhost:8000/viewer/ (no network needed).\n");
+  if (!a.no_export)
+    ro.extra_md.push_back(
+        "## Exports\n\n`export/`: the LR input (`lr`), the GDSR prediction (`gdsr`) and the HR simulation (`hr`) as "
+        "glTF 2.0 with a morph-target animation (`NAME.gltf` + `NAME.bin`; Blender: File > Import > glTF 2.0, shading "
+        "Smooth) and "
+        "as a PC2 point cache on a rest OBJ (`NAME_rest.obj` + `NAME.pc2`; Blender: import the OBJ, add a Mesh "
+        "Cache modifier, format PC2, frame start 0). See docs/exports.md. `export/export.json` lists them.\n");
+  const auto files = gdsr::write_eval_report(a.report, d, p, e, ro);  // checks the steps first
+  if (!a.no_export) {
+    gdsr::RolloutExportOptions eo;
+    eo.formats.obj = false;
+    gdsr::export_rollout((fs::path(a.report) / "export").string(), d, p.G, p.first_frame, eo);
+  }
+  if (viewer) gdsr::write_viewer(a.report, viewer_src);
+  std::printf("wrote report %s: %zu files (report.md, report.json, plots/, images/%s%s%s)\n", a.report.c_str(),
+              files.size(), a.no_video ? "" : ", rollout.avi", a.no_export ? "" : ", export/",
+              viewer ? ", viewer/" : "");
+}
 
 void print_evaluation(const gdsr::Evaluation& e) {
   std::printf("evaluation over %zu frames (mean):\n", e.frames.size());
@@ -31,35 +81,27 @@ void print_evaluation(const gdsr::Evaluation& e) {
 }  // namespace
 
 void add_eval_command(CLI::App& app) {
-  auto a = std::make_shared<RolloutArgs>();
+  auto a = std::make_shared<EvalArgs>();
   CLI::App* c = app.add_subcommand("eval", "roll out (or load a prediction) and compare with the HR simulation");
-  auto* src = c->add_option_group("source");
-  src->add_option("--model", a->model, "checkpoint: roll out now");
-  src->add_option("--pred", a->pred, "folder written by gdsr infer");
-  src->require_option(1);
+  gdsr_cli::add_source_options(c, *a);
   gdsr_cli::add_rollout_options(c, *a);
   c->add_option("--ssim-every", a->ssim_every, "SSIM on every k-th frame")->capture_default_str();
+  c->add_option("--report", a->report, "write a report folder: tables, plots, images, video, exports");
+  c->add_option("--report-steps", a->image_steps,
+                "roll-out steps (1 = first frame) with images (default: 1 50 100 500 last)")
+      ->delimiter(',');
+  c->add_option("--video-every", a->video_every, "report video: every k-th frame")->capture_default_str();
+  c->add_flag("--no-video", a->no_video, "report without the video");
+  c->add_flag("--no-export", a->no_export, "report without the glTF / PC2 exports (and the viewer)");
+  c->add_flag("--no-viewer", a->no_viewer, "report without the browser viewer");
   c->callback([a]() {
+    if (a->video_every < 1) gdsr::fail("--video-every", "must be at least 1");
     const gdsr::Dataset d = gdsr::load_dataset(a->data);
-    std::vector<gdsr::Points3> G;
-    int first = a->opt.first_frame;
-    if (!a->model.empty()) {
-      G = gdsr_cli::run_rollout(*a, d).G;
-    } else {
-      namespace fs = std::filesystem;
-      G = gdsr::array_to_frames(gdsr::read_array((fs::path(a->pred) / "pred_hr.bin").string()), a->pred);
-      const std::string meta = (fs::path(a->pred) / "prediction.json").string();
-      std::ifstream in(meta);
-      if (!in) gdsr::fail(meta, "cannot open (not a folder written by gdsr infer?)");
-      try {
-        first = nlohmann::json::parse(in).at("first_frame").get<int>();
-      } catch (const nlohmann::json::exception& e) {
-        gdsr::fail(meta, e.what());
-      }
-    }
+    const gdsr::Prediction p = gdsr_cli::obtain_prediction(*a, d);
     gdsr::ProgressBar bar("evaluate");
-    const gdsr::Evaluation e = gdsr::evaluate(d, G, first, a->ssim_every, bar.callback());
+    const gdsr::Evaluation e = gdsr::evaluate(d, p.G, p.first_frame, a->ssim_every, bar.callback());
     bar.finish();
     print_evaluation(e);
+    if (!a->report.empty()) write_report(*a, d, p, e);
   });
 }

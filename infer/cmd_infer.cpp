@@ -6,7 +6,6 @@
 #include "infer/cmd_rollout_common.hpp"
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include <cstdio>
 #include <filesystem>
@@ -18,15 +17,7 @@ namespace {
 
 void write_prediction(const RolloutArgs& a, const gdsr::Dataset& d, const gdsr::RolloutResult& r) {
   namespace fs = std::filesystem;
-  fs::create_directories(a.out);
-  gdsr::write_array((fs::path(a.out) / "pred_hr.bin").string(), gdsr::frames_to_array(r.G));
-  gdsr::write_array((fs::path(a.out) / "pred_lr.bin").string(), gdsr::frames_to_array(r.C_hat));
-  nlohmann::json j{{"first_frame", r.first_frame},
-                   {"frames", r.G.size()},
-                   {"dataset", a.data},
-                   {"model", a.model},
-                   {"seconds_per_frame", r.seconds_per_frame}};
-  gdsr::write_file_atomic((fs::path(a.out) / "prediction.json").string(), j.dump(2));
+  gdsr::write_prediction(a.out, gdsr_cli::to_prediction(a, r));
   if (a.obj_every > 0)
     for (size_t k = 0; k < r.G.size(); k += static_cast<size_t>(a.obj_every)) {
       gdsr::GarmentMesh m = d.hr;

@@ -29,6 +29,30 @@ gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d) {
   return r;
 }
 
+void add_source_options(CLI::App* c, RolloutArgs& a) {
+  auto* src = c->add_option_group("source");
+  src->add_option("--model", a.model, "checkpoint: roll out now");
+  src->add_option("--pred", a.pred, "folder written by gdsr infer");
+  src->require_option(1);
+}
+
+gdsr::Prediction obtain_prediction(const RolloutArgs& a, const gdsr::Dataset& d) {
+  if (a.model.empty()) return gdsr::read_prediction(a.pred, true);
+  return to_prediction(a, run_rollout(a, d));
+}
+
+gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r) {
+  gdsr::Prediction p;
+  p.first_frame = r.first_frame;
+  p.G = std::move(r.G);
+  p.C_hat = std::move(r.C_hat);
+  p.dataset = a.data;
+  p.model = a.model;
+  p.seconds_per_frame = r.seconds_per_frame;
+  p.model_seconds_per_frame = r.model_seconds_per_frame;
+  return p;
+}
+
 void add_rollout_options(CLI::App* c, RolloutArgs& a) {
   c->add_option("--data", a.data, "dataset folder (LR input; HR for eval)")->required();
   c->add_option("--first", a.opt.first_frame, "first frame")->capture_default_str();

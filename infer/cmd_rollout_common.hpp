@@ -3,6 +3,7 @@
 #pragma once
 
 #include "gdsr/data/dataset.hpp"
+#include "infer/prediction_io.hpp"
 #include "infer/rollout.hpp"
 
 #include <string>
@@ -24,7 +25,16 @@ struct RolloutArgs {
 // Loads the checkpoint a.model, rolls it out over d with a progress bar, prints a summary.
 gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d);
 
+// The roll-out as a prediction (named after a.data and a.model).
+gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r);
+
 // --data, --first, --frames, --no-collisions.
 void add_rollout_options(CLI::App* c, RolloutArgs& a);
+
+// --model (roll out now) or --pred (a folder written by gdsr infer): exactly one.
+void add_source_options(CLI::App* c, RolloutArgs& a);
+
+// The prediction of the chosen source: run_rollout for --model, read_prediction for --pred.
+gdsr::Prediction obtain_prediction(const RolloutArgs& a, const gdsr::Dataset& d);
 
 }  // namespace gdsr_cli

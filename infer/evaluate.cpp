@@ -41,6 +41,16 @@ double ssim(const cv::Mat& a, const cv::Mat& b) {
   return (s[0] + s[1] + s[2]) / 3.0;
 }
 
+namespace {
+
+void add_scaled(StrainEnergies& sum, const StrainEnergies& e, double w) {
+  sum.E_u += w * e.E_u;
+  sum.E_v += w * e.E_v;
+  sum.E_uv += w * e.E_uv;
+}
+
+}  // namespace
+
 Evaluation evaluate(const Dataset& d, const std::vector<Points3>& G, int first_frame, int ssim_every,
                     const ProgressFn& progress) {
   const int T = static_cast<int>(d.hr_frames.size());
@@ -65,6 +75,7 @@ Evaluation evaluate(const Dataset& d, const std::vector<Points3>& G, int first_f
     f.error_lr = (up - truth).rowwise().norm().mean();
     if (k % ssim_every == 0) {
       const cv::Mat ref = uv_normal_map(d.raster, d.hr.F, truth);
+      f.has_ssim = true;
       f.ssim = ssim(uv_normal_map(d.raster, d.hr.F, G[k]), ref);
       f.ssim_lr = ssim(uv_normal_map(d.raster, d.hr.F, up), ref);
       ev.mean.ssim += f.ssim;
@@ -72,15 +83,13 @@ Evaluation evaluate(const Dataset& d, const std::vector<Points3>& G, int first_f
       ++n_ssim;
     }
     f.energies = strain_energies(d.hr, G[k]);
-    const StrainEnergies te = strain_energies(d.hr, truth);
-    ev.truth.E_u += te.E_u / count;
-    ev.truth.E_v += te.E_v / count;
-    ev.truth.E_uv += te.E_uv / count;
+    f.energies_lr = strain_energies(d.hr, up);
+    f.energies_hr = strain_energies(d.hr, truth);
     ev.mean.error += f.error / count;
     ev.mean.error_lr += f.error_lr / count;
-    ev.mean.energies.E_u += f.energies.E_u / count;
-    ev.mean.energies.E_v += f.energies.E_v / count;
-    ev.mean.energies.E_uv += f.energies.E_uv / count;
+    add_scaled(ev.mean.energies, f.energies, 1.0 / count);
+    add_scaled(ev.mean.energies_lr, f.energies_lr, 1.0 / count);
+    add_scaled(ev.mean.energies_hr, f.energies_hr, 1.0 / count);
     ev.frames.push_back(f);
     if (progress) progress(k + 1, count);
   }
@@ -89,6 +98,7 @@ Evaluation evaluate(const Dataset& d, const std::vector<Points3>& G, int first_f
     ev.mean.ssim_lr /= n_ssim;
   }
   ev.mean.frame = -1;
+  ev.truth = ev.mean.energies_hr;
   return ev;
 }
 

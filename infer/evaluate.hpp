@@ -23,16 +23,19 @@ double ssim(const cv::Mat& a, const cv::Mat& b);
 
 struct FrameEvaluation {
   int frame = 0;
-  double error = 0;         // mean |G - G*| over HR vertices, metres
-  double error_lr = 0;      // the same for the LR simulation upsampled (baseline)
-  double ssim = 0;          // normal maps of G vs G*
-  double ssim_lr = 0;       // normal maps of the upsampled LR vs G*
-  StrainEnergies energies;  // of G
+  double error = 0;            // mean |G - G*| over HR vertices, metres
+  double error_lr = 0;         // the same for the LR simulation upsampled (baseline)
+  bool has_ssim = false;       // SSIM computed on this frame (every ssim_every-th)
+  double ssim = 0;             // normal maps of G vs G*
+  double ssim_lr = 0;          // normal maps of the upsampled LR vs G*
+  StrainEnergies energies;     // of G
+  StrainEnergies energies_lr;  // of the upsampled LR (baseline)
+  StrainEnergies energies_hr;  // of the ground truth G*
 };
 
 struct Evaluation {
   std::vector<FrameEvaluation> frames;
-  FrameEvaluation mean;  // averages (frame = -1)
+  FrameEvaluation mean;  // averages (frame = -1); mean.energies_hr == truth
   StrainEnergies truth;  // of the ground truth, averaged over the same frames
 };
 

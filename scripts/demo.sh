@@ -5,7 +5,8 @@
 #        motion capture: clip 01_01 for training, 01_03 (unseen motion) for testing;
 #   4.   `gdsr train`: a small GDSR model on the training sequence;
 #   5.   `gdsr infer` + `gdsr eval`: roll-out on the unseen motion, compared with the HR
-#        simulation (vertex error, normal-map SSIM, stretch energies) and a preview PNG.
+#        simulation (vertex error, normal-map SSIM, stretch energies) and a preview PNG;
+#        the report folder runs/demo/report (tables, plots, images, video, glTF / PC2 exports).
 # Outputs go to runs/demo (override with GDSR_DEMO_OUT). Datasets already made are reused.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -32,5 +33,6 @@ echo "== 4. Train GDSR (configs/small.json) =="
 
 echo "== 5. Roll-out on the unseen motion 01_03, evaluation =="
 "$gdsr" infer --model "$out/model/model.ckpt" --data "$out/test_skirt_01_03" --out "$out/infer"
-"$gdsr" eval --pred "$out/infer" --data "$out/test_skirt_01_03"
+"$gdsr" eval --pred "$out/infer" --data "$out/test_skirt_01_03" --report "$out/report"
 echo "previews: $out/data_preview.png $out/infer/preview.png"
+echo "report: $out/report/report.md (plots, LR | GDSR | HR images, rollout.avi, glTF / PC2 exports in export/)"

@@ -6,17 +6,27 @@ cd "$(dirname "$0")/.."
 
 packages=(g++ cmake make libeigen3-dev libassimp-dev assimp-testmodels libembree-dev
           libopencv-dev doctest-dev libcli11-dev nlohmann-json3-dev libnanoflann-dev
-          libcgal-dev libbenchmark-dev)
+          libcgal-dev libbenchmark-dev
+          blender python3-numpy  # the test that Blender opens the glTF / OBJ / PC2 exports
+          chromium)              # the test of the report's browser viewer (headless)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+command -v npm >/dev/null || missing+=(npm)  # three.js for the viewer (any npm will do)
 if [ ${#missing[@]} -gt 0 ]; then
   echo "setup: installing ${missing[*]}"
   sudo_cmd=""
   [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
   $sudo_cmd apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# three.js for the report's browser viewer, at the exact version in viewer/package.json (it has
+# no dependencies of its own, so no lock file).
+if [ ! -f viewer/node_modules/three/build/three.module.js ]; then
+  echo "setup: installing three.js into viewer/node_modules (npm)"
+  (cd viewer && npm install --no-package-lock --no-audit --no-fund --loglevel=error >/dev/null)
 fi
 
 jobs=$(nproc 2>/dev/null || echo 2)

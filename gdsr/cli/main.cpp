@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   add_train_command(app);
   add_infer_command(app);
   add_eval_command(app);
+  add_export_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,5 +1,5 @@
-// Runs the built gdsr executable from a CLI test and checks its one-line errors (test code,
-// header only).
+// Running the built gdsr executable from the CLI tests: exit status, stdout and stderr, and
+// the check that a failure is one line "gdsr: error: ..." (header only, test code).
 #pragma once
 
 #include "tests/support/data_fixtures.hpp"
