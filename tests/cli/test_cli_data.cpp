@@ -133,7 +133,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest; values out 
                                    "' --seconds 0.1 --lr-pd 0.08 --hr-pd 0.06 --rest-blend 2 --raster 64"
                                    " --iterations 3 --friction 0.1 --self-thickness 0.002 --no-self-collision");
   REQUIRE(mk.status == 0);
-  const std::string manifest = slurp(out + "/manifest.json");
+  const std::string manifest = gdsr_test::slurp(out + "/manifest.json");
   CHECK(manifest.find("\"iterations\": 3") != std::string::npos);
   CHECK(manifest.find("\"friction\": 0.1") != std::string::npos);
   CHECK(manifest.find("\"self_collision\": false") != std::string::npos);

