@@ -7,6 +7,7 @@ cd "$(dirname "$0")/.."
 packages=(g++ cmake make libeigen3-dev libassimp-dev assimp-testmodels libembree-dev
           libopencv-dev doctest-dev libcli11-dev nlohmann-json3-dev libnanoflann-dev
           libcgal-dev libbenchmark-dev
+          libopenmpi-dev openmpi-bin  # data-parallel training (cmake -DGDSR_MPI=ON; CI builds with it)
           blender python3-numpy  # the test that Blender opens the glTF / OBJ / PC2 exports
           chromium)              # the test of the report's browser viewer (headless)
 missing=()

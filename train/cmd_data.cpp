@@ -41,7 +41,7 @@ struct MakeArgs {
   double fps = 30;
   int substeps = -1;  // <0: the solver's default
   // Solver knobs (NaN / <0: the solver's default, sim::SimParams).
-  int iterations = -1;
+  int iterations = -1, stretch_passes = -1;
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN;
   bool self_collision = true;
   int rest_blend_frames = 15;
@@ -126,6 +126,7 @@ void run_make(const MakeArgs& a) {
   sim::SimParams params;
   if (a.substeps > 0) params.substeps = a.substeps;
   if (a.iterations > 0) params.iterations = a.iterations;
+  if (a.stretch_passes > 0) params.stretch_passes = a.stretch_passes;
   if (!std::isnan(a.friction)) params.friction = a.friction;
   if (!std::isnan(a.bend_stiffness)) params.bend_stiffness = a.bend_stiffness;
   if (!std::isnan(a.self_thickness)) params.self_thickness = a.self_thickness;
@@ -155,6 +156,7 @@ void run_make(const MakeArgs& a) {
   m.sim_params = {{"solver", "xpbd"},
                   {"substeps", params.substeps},
                   {"iterations", params.iterations},
+                  {"stretch_passes", params.stretch_passes},
                   {"thickness_m", params.thickness},
                   {"friction", params.friction},
                   {"density_kg_m2", params.density},
@@ -378,6 +380,8 @@ void add_data_command(CLI::App& app) {
   make->add_option("--fps", mk->fps, "frames per second")->capture_default_str();
   make->add_option("--substeps", mk->substeps, "solver substeps per frame (default: the solver's)");
   make->add_option("--iterations", mk->iterations, "constraint passes per substep (default: the solver's)")
+      ->check(CLI::Range(1, 100));
+  make->add_option("--stretch-passes", mk->stretch_passes, "stretch passes per iteration (default: the solver's)")
       ->check(CLI::Range(1, 100));
   make->add_option("--friction", mk->friction, "Coulomb friction against the body (default: the solver's)")
       ->check(CLI::Range(0.0, 2.0));

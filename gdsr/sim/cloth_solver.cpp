@@ -49,8 +49,8 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
   const int nv = static_cast<int>(m.V.rows());
   if (nv == 0 || m.F.rows() == 0) gdsr::fail("sim/cloth_solver", "garment '" + g.name + "' is empty");
   if (m.FUV.rows() != m.F.rows()) gdsr::fail("sim/cloth_solver", "garment F and FUV differ in face count");
-  if (p.substeps < 1 || p.iterations < 1 || p.contact_every < 1)
-    gdsr::fail("sim/cloth_solver", "substeps, iterations and contact_every must be >= 1");
+  if (p.substeps < 1 || p.iterations < 1 || p.contact_every < 1 || p.stretch_passes < 1)
+    gdsr::fail("sim/cloth_solver", "substeps, iterations, stretch_passes and contact_every must be >= 1");
   if (!(p.density > 0) || !(p.stretch_stiffness > 0) || !(p.bend_stiffness > 0))
     gdsr::fail("sim/cloth_solver", "density and stiffnesses must be positive");
   if (body_F.rows() > 0 && body_F.maxCoeff() >= body_V0.rows())
@@ -390,8 +390,10 @@ void ClothSolver::step(const Points3& body_from, const Points3& body_to, double 
     std::fill(lambda_e.begin(), lambda_e.end(), 0.0);
     std::fill(lambda_b.begin(), lambda_b.end(), 0.0);
     for (int it = 0; it < p_.iterations; ++it) {
-      solve_edges(lambda_e, h2);
-      project_tethers(tethers_, p_.tether_stretch, x_);
+      for (int k = 0; k < p_.stretch_passes; ++k) {
+        solve_edges(lambda_e, h2);
+        project_tethers(tethers_, p_.tether_stretch, x_);
+      }
       if (!implicit_bending_) solve_bends(lambda_b, h2);
       solve_layers();
       solve_body_contacts(body_prev, body_now);

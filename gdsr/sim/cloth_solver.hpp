@@ -49,6 +49,7 @@ struct SimParams {
   double self_slack = 0.003;      // m, how far a vertex may leave its predicted path before re-detection
   int self_passes = 1;            // self-contact Gauss-Seidel passes per iteration (stops early when none is violated)
   bool implicit_bending = true;   // bending by one linear solve per substep (sim/cloth_bending_solve.hpp)
+  int stretch_passes = 4;         // stretch (+ tether) passes per iteration: cheap (~1% of a substep each)
   bool tethers = true;            // long-range attachments to the pins (sim/cloth_tethers.hpp)
   double tether_stretch = 0.002;  // stretch a tether allows beyond the rest distance along the cloth (0.2%)
 };
