@@ -24,8 +24,8 @@ gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d) {
   std::printf(
       "rolled out %zu frames: %.3f s/frame (model %.3f s), LR %lld -> HR %lld vertices, %d HR vertices "
       "moved by collision handling\n",
-      r.G.size(), r.seconds_per_frame, r.model_seconds_per_frame, static_cast<long long>(d.lr_frames[0].rows()),
-      static_cast<long long>(d.hr_frames[0].rows()), pushed);
+      r.G.size(), r.seconds_per_frame, r.model_seconds_per_frame, static_cast<long long>(d.lr.V.rows()),
+      static_cast<long long>(d.hr.V.rows()), pushed);
   return r;
 }
 
@@ -53,8 +53,9 @@ gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r) {
   return p;
 }
 
-void add_rollout_options(CLI::App* c, RolloutArgs& a) {
-  c->add_option("--data", a.data, "dataset folder (LR input; HR for eval)")->required();
+void add_rollout_options(CLI::App* c, RolloutArgs& a, bool data_required) {
+  auto* data = c->add_option("--data", a.data, "dataset folder (LR input; HR for eval)");
+  if (data_required) data->required();
   c->add_option("--first", a.opt.first_frame, "first frame")->capture_default_str();
   c->add_option("--frames", a.opt.frames, "number of frames (-1: to the end)")->capture_default_str();
   c->add_flag("--no-collisions", a.no_collisions, "skip the explicit collision handling");

@@ -28,8 +28,8 @@ gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d);
 // The roll-out as a prediction (named after a.data and a.model).
 gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r);
 
-// --data, --first, --frames, --no-collisions.
-void add_rollout_options(CLI::App* c, RolloutArgs& a);
+// --data (required unless data_required is false), --first, --frames, --no-collisions.
+void add_rollout_options(CLI::App* c, RolloutArgs& a, bool data_required = true);
 
 // --model (roll out now) or --pred (a folder written by gdsr infer): exactly one.
 void add_source_options(CLI::App* c, RolloutArgs& a);

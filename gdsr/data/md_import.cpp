@@ -32,28 +32,6 @@ long last_number(const std::string& name) {
   return value;
 }
 
-// Reads a per-frame sequence; all frames must share the first frame's faces.
-std::vector<ObjData> read_sequence(const std::string& dir, const std::string& what, int& done, int total,
-                                   const ProgressFn& progress) {
-  std::vector<ObjData> out;
-  for (const std::string& path : list_frame_objs(dir)) {
-    ObjData d = read_obj(path);
-    if (!out.empty()) {
-      if (d.V.rows() != out[0].V.rows())
-        gdsr::fail("import-md", std::string(path) + ": " + std::to_string(d.V.rows()) + " vertices, the first " + what +
-                                    " frame has " + std::to_string(out[0].V.rows()) + " (vertex count mismatch)");
-      if (d.F.rows() != out[0].F.rows() || d.F != out[0].F)
-        gdsr::fail("import-md", std::string(path) + ": faces differ from the first " + what + " frame");
-      d.F.resize(0, 3);  // only the first frame keeps faces
-      d.FT.resize(0, 3);
-    }
-    d.VT.resize(0, 2);
-    out.push_back(std::move(d));
-    if (progress) progress(++done, total);
-  }
-  return out;
-}
-
 size_t count_objs(const std::string& dir) { return list_frame_objs(dir).size(); }
 
 // Applies a weld map to a sequence: faces re-indexed (first frame), positions compacted.
@@ -90,6 +68,44 @@ std::vector<std::string> list_frame_objs(const std::string& dir) {
   return out;
 }
 
+std::vector<std::string> list_frame_sequence(const std::string& dir) {
+  std::vector<std::string> paths = list_frame_objs(dir);
+  long prev = -1, step = 0;
+  for (size_t i = 0; i < paths.size(); ++i) {
+    const long n = last_number(fs::path(paths[i]).stem().string());
+    if (n < 0 && paths.size() > 1)
+      gdsr::fail(paths[i], "no frame number in the file name (one OBJ per frame, numbered)");
+    if (i == 1) step = n - prev;
+    if (i >= 1 && (n == prev || n - prev != step))
+      gdsr::fail(paths[i], n == prev ? "frame number " + std::to_string(n) + " appears twice"
+                                     : "frame " + std::to_string(n) + " follows frame " + std::to_string(prev) +
+                                           " (step " + std::to_string(step) + " before): missing frames");
+    prev = n;
+  }
+  return paths;
+}
+
+std::vector<ObjData> read_frame_sequence(const std::vector<std::string>& paths, const std::string& where,
+                                         const std::string& what, int& done, int total, const ProgressFn& progress) {
+  std::vector<ObjData> out;
+  for (const std::string& path : paths) {
+    ObjData d = read_obj(path);
+    if (!out.empty()) {
+      if (d.V.rows() != out[0].V.rows())
+        gdsr::fail(where, std::string(path) + ": " + std::to_string(d.V.rows()) + " vertices, the first " + what +
+                              " frame has " + std::to_string(out[0].V.rows()) + " (vertex count mismatch)");
+      if (d.F.rows() != out[0].F.rows() || d.F != out[0].F)
+        gdsr::fail(where, std::string(path) + ": faces differ from the first " + what + " frame");
+      d.F.resize(0, 3);  // only the first frame keeps faces
+      d.FT.resize(0, 3);
+    }
+    d.VT.resize(0, 2);
+    out.push_back(std::move(d));
+    if (progress) progress(++done, total);
+  }
+  return out;
+}
+
 std::vector<int> weld_map(const Points3& V, double eps, int& count) {
   if (!(eps > 0)) gdsr::fail("import-md", "weld distance must be positive");
   auto key = [&](long x, long y, long z) { return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791); };
@@ -123,16 +139,15 @@ std::vector<int> weld_map(const Points3& V, double eps, int& count) {
 
 GarmentMesh garment_from_flat(const ObjData& flat, const ObjData& frame, const std::string& what) {
   if (flat.F.rows() != frame.F.rows())
-    gdsr::fail("import-md", std::string(what) + ": the flattened OBJ has " + std::to_string(flat.F.rows()) +
-                                " triangles, the 3-D mesh " + std::to_string(frame.F.rows()) +
-                                " (faces must correspond one to one)");
+    gdsr::fail(what, "the flattened OBJ has " + std::to_string(flat.F.rows()) + " triangles, the 3-D mesh " +
+                         std::to_string(frame.F.rows()) + " (faces must correspond one to one)");
   // Drop the coordinate with the smallest extent: the pattern lies in the other two.
   const Eigen::RowVector3d ext = flat.V.colwise().maxCoeff() - flat.V.colwise().minCoeff();
   int drop = 0;
   ext.minCoeff(&drop);
   const int a = drop == 0 ? 1 : 0, b = drop == 2 ? 1 : 2;
   if (ext(drop) > 1e-3 * ext.maxCoeff())
-    gdsr::fail("import-md", std::string(what) + ": the flattened OBJ is not planar");
+    gdsr::fail(what, "the flattened OBJ is not planar");
   ObjData merged;
   merged.V = frame.V;
   merged.F = frame.F;
@@ -156,8 +171,10 @@ Dataset import_md(const MdImportOptions& opt) {
   int done = 0;
 
   Dataset d;
-  std::vector<ObjData> lr = read_sequence(opt.lr_dir, "LR", done, total, opt.progress);
-  std::vector<ObjData> hr = read_sequence(opt.hr_dir, "HR", done, total, opt.progress);
+  std::vector<ObjData> lr =
+      read_frame_sequence(list_frame_objs(opt.lr_dir), "import-md", "LR", done, total, opt.progress);
+  std::vector<ObjData> hr =
+      read_frame_sequence(list_frame_objs(opt.hr_dir), "import-md", "HR", done, total, opt.progress);
   if (opt.weld > 0) {
     int n = 0;
     const std::vector<int> lm = weld_map(lr[0].V * opt.scale, opt.weld, n);
@@ -178,7 +195,8 @@ Dataset import_md(const MdImportOptions& opt) {
   lr.clear();
   hr.clear();
   if (!opt.body_dir.empty()) {
-    std::vector<ObjData> body = read_sequence(opt.body_dir, "body", done, total, opt.progress);
+    std::vector<ObjData> body =
+        read_frame_sequence(list_frame_objs(opt.body_dir), "import-md", "body", done, total, opt.progress);
     d.body_faces = body[0].F;
     for (auto& f : body) d.body_frames.push_back(f.V * opt.scale);
   }

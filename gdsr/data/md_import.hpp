@@ -35,6 +35,16 @@ Dataset import_md(const MdImportOptions& opt);
 // the folder is missing or holds none.
 std::vector<std::string> list_frame_objs(const std::string& dir);
 
+// list_frame_objs, and the frame numbers must step evenly (0,1,2,... or 0,5,10,...): a gap
+// (missing frames) or a repeated number throws naming the file.
+std::vector<std::string> list_frame_sequence(const std::string& dir);
+
+// Reads one OBJ per path; every frame must have the first frame's vertex count and faces
+// (errors "<where>: <file>: ..."). Only the first frame keeps F (and FT); VT is dropped.
+// progress(++done, total) after each file.
+std::vector<ObjData> read_frame_sequence(const std::vector<std::string>& paths, const std::string& where,
+                                         const std::string& what, int& done, int total, const ProgressFn& progress);
+
 // Welding map of V: each vertex joins the first earlier kept vertex within eps (hash grid of
 // cell eps), otherwise it is kept. Returns old vertex -> new compact index (kept vertices in
 // their original order); count = number of kept vertices.
