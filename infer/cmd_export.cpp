@@ -50,22 +50,31 @@ void add_export_command(CLI::App& app) {
   auto a = std::make_shared<ExportArgs>();
   CLI::App* c = app.add_subcommand("export", "write a roll-out as glTF, PC2 + rest OBJ and OBJ per frame");
   gdsr_cli::add_source_options(c, a->rollout);
-  gdsr_cli::add_rollout_options(c, a->rollout);
+  gdsr_cli::add_rollout_options(c, a->rollout, false);
+  gdsr_cli::add_sequence_options(c, a->rollout);
   c->add_option("--out", a->out, "output folder")->capture_default_str();
   c->add_option("--formats", a->formats, "comma-separated: gltf, pc2, obj")->capture_default_str();
-  c->add_option("--sequences", a->sequences, "comma-separated: gdsr (prediction), lr (input), hr (simulation)")
-      ->capture_default_str();
+  CLI::Option* sequences =
+      c->add_option("--sequences", a->sequences,
+                    "comma-separated: gdsr (prediction), lr (input), hr (simulation; not with --lr-dir)")
+          ->capture_default_str();
   c->add_option("--obj-every", a->obj_every, "OBJ for every k-th frame")->capture_default_str();
-  c->callback([a]() {
+  c->callback([a, sequences]() {
     const auto formats = split_names(a->formats, "--formats", {"gltf", "pc2", "obj"});
     const auto seqs = split_names(a->sequences, "--sequences", {"gdsr", "lr", "hr"});
     if (a->obj_every < 1) gdsr::fail("--obj-every", "must be at least 1");
-    const gdsr::Dataset d = gdsr::load_dataset(a->rollout.data);
+    const gdsr::Dataset d = gdsr_cli::load_input(a->rollout);
     const gdsr::Prediction p = gdsr_cli::obtain_prediction(a->rollout, d);
+    for (const gdsr::Points3& g : p.G)
+      if (g.rows() != d.hr.V.rows())
+        gdsr::fail(a->rollout.pred.empty() ? a->rollout.model : a->rollout.pred + "/pred_hr.bin",
+                   std::to_string(g.rows()) + " HR vertices per frame, the HR garment has " +
+                       std::to_string(d.hr.V.rows()) + " (same --data or --lr-dir/--hr-uv/--subdivide as gdsr infer?)");
     gdsr::RolloutExportOptions opt;
     opt.gdsr = has(seqs, "gdsr");
     opt.lr = has(seqs, "lr");
     opt.hr = has(seqs, "hr");
+    if (d.hr_frames.empty() && sequences->count() == 0) opt.hr = false;  // --lr-dir: no HR simulation
     opt.formats.gltf = has(formats, "gltf");
     opt.formats.pc2 = has(formats, "pc2");
     opt.formats.obj = has(formats, "obj");

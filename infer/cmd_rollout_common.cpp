@@ -1,6 +1,7 @@
 #include "infer/cmd_rollout_common.hpp"
 
 #include "gdsr/cli/progress_bar.hpp"
+#include "gdsr/error.hpp"
 #include "gdsr/model/gdsr_model.hpp"
 #include "gdsr/model/model_checkpoint.hpp"
 #include "nn/checkpoint.hpp"
@@ -46,7 +47,7 @@ gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r) {
   p.first_frame = r.first_frame;
   p.G = std::move(r.G);
   p.C_hat = std::move(r.C_hat);
-  p.dataset = a.data;
+  p.dataset = a.data.empty() ? "lr-dir:" + a.seq.lr_dir : a.data;
   p.model = a.model;
   p.seconds_per_frame = r.seconds_per_frame;
   p.model_seconds_per_frame = r.model_seconds_per_frame;
@@ -59,6 +60,40 @@ void add_rollout_options(CLI::App* c, RolloutArgs& a, bool data_required) {
   c->add_option("--first", a.opt.first_frame, "first frame")->capture_default_str();
   c->add_option("--frames", a.opt.frames, "number of frames (-1: to the end)")->capture_default_str();
   c->add_flag("--no-collisions", a.no_collisions, "skip the explicit collision handling");
+}
+
+void add_sequence_options(CLI::App* c, RolloutArgs& a) {
+  gdsr::SequenceImportOptions& s = a.seq;
+  auto* own = c->add_option_group("own sequence", "your own LR simulation (per-frame OBJs) instead of --data");
+  own->add_option("--lr-dir", s.lr_dir,
+                  "folder of LR OBJs, one per frame (sorted by the number in the name; same faces in every frame)");
+  own->add_option("--lr-uv", s.lr_uv, "flattened LR pattern OBJ (2-D layout in v, faces as the 3-D frames)");
+  own->add_option("--hr-uv", s.hr_uv, "HR garment OBJ with v (3-D) and vt (pattern in the LR pattern's units)");
+  own->add_option("--subdivide", s.subdivide, "without --hr-uv: HR = LR after 1 or 2 midpoint subdivisions")
+      ->capture_default_str();
+  own->add_option("--body-dir", s.body_dir, "folder of body OBJs, one per LR frame (optional)");
+  own->add_option("--scale", s.scale, "file units -> metres (Marvelous Designer mm: 0.001)")->capture_default_str();
+  own->add_option("--fps", s.fps, "frames per second of the OBJ sequence")->capture_default_str();
+}
+
+gdsr::Dataset load_input(const RolloutArgs& a) {
+  const gdsr::SequenceImportOptions& s = a.seq;
+  if (a.data.empty() == s.lr_dir.empty()) gdsr::fail("--data", "give exactly one of --data and --lr-dir");
+  if (!a.data.empty()) {
+    if (!s.lr_uv.empty() || !s.hr_uv.empty() || !s.body_dir.empty())
+      gdsr::fail("--data", "--lr-uv, --hr-uv and --body-dir go with --lr-dir, not --data");
+    return gdsr::load_dataset(a.data);
+  }
+  if (s.lr_uv.empty()) gdsr::fail("--lr-uv", "required with --lr-dir (the flattened LR pattern OBJ)");
+  gdsr::SequenceImportOptions opt = s;
+  gdsr::ProgressBar bar("read OBJs");
+  opt.progress = bar.callback();
+  gdsr::Dataset d = gdsr::import_lr_sequence(opt);
+  bar.finish();
+  const std::string hr = s.hr_uv.empty() ? "LR subdivided " + std::to_string(s.subdivide) + "x" : s.hr_uv;
+  std::printf("read %d frames: LR %d vertices, HR %d vertices (%s)\n", d.manifest.frames, d.manifest.lr_vertices,
+              d.manifest.hr_vertices, hr.c_str());
+  return d;
 }
 
 }  // namespace gdsr_cli

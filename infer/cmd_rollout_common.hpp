@@ -3,6 +3,7 @@
 #pragma once
 
 #include "gdsr/data/dataset.hpp"
+#include "gdsr/data/sequence_import.hpp"
 #include "infer/prediction_io.hpp"
 #include "infer/rollout.hpp"
 
@@ -20,6 +21,7 @@ struct RolloutArgs {
   bool no_collisions = false;
   int obj_every = 0;
   int ssim_every = 1;
+  gdsr::SequenceImportOptions seq;  // the user's own LR sequence (--lr-dir ...) instead of data
 };
 
 // Loads the checkpoint a.model, rolls it out over d with a progress bar, prints a summary.
@@ -30,6 +32,13 @@ gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r);
 
 // --data (required unless data_required is false), --first, --frames, --no-collisions.
 void add_rollout_options(CLI::App* c, RolloutArgs& a, bool data_required = true);
+
+// --lr-dir, --lr-uv, --hr-uv, --subdivide, --body-dir, --scale, --fps: the user's own LR
+// OBJ sequence (gdsr/data/sequence_import.hpp) instead of --data.
+void add_sequence_options(CLI::App* c, RolloutArgs& a);
+
+// The input: the dataset folder a.data or the user's sequence a.seq (exactly one given).
+gdsr::Dataset load_input(const RolloutArgs& a);
 
 // --model (roll out now) or --pred (a folder written by gdsr infer): exactly one.
 void add_source_options(CLI::App* c, RolloutArgs& a);

@@ -156,6 +156,17 @@ TEST_CASE("infer cli: own OBJ sequence in HR subdivided or from an HR OBJ") {
   CHECK(sub.out.find("read 11 frames") != std::string::npos);
   check_prediction(dir / "sub", kFrames, lr_v + edges, lr_v);
   CHECK(fs::exists(dir / "sub/preview.png"));
+  // gdsr export on the prediction, with the same input flags in place of --data.
+  const std::string exp = " --lr-dir '" + (dir / "lr") + "' --lr-uv '" + (dir / "lr_flat.obj") + "' --scale 0.001";
+  const Run ex = gdsr_run(dir, "export --pred '" + (dir / "sub") + "'" + exp + " --out '" + (dir / "exp") + "'");
+  REQUIRE_MESSAGE(ex.status == 0, ex.err);
+  CHECK(fs::exists(dir / "exp/gdsr.gltf"));
+  CHECK(fs::exists(dir / "exp/lr.gltf"));
+  CHECK_FALSE(fs::exists(dir / "exp/hr.gltf"));  // no HR simulation of the user's sequence
+  check_one_line_error(gdsr_run(dir, "export --pred '" + (dir / "sub") + "'" + exp + " --subdivide 2 --out '" +
+                                         (dir / "exp2") + "'"),
+                       "vertices");
+  CHECK_FALSE(fs::exists(dir / "exp2"));
 
   const Run sub2 = gdsr_run(dir, base + " --subdivide 2 --frames 2 --obj-every 1 --out '" + (dir / "sub2") + "'");
   REQUIRE_MESSAGE(sub2.status == 0, sub2.err);
