@@ -109,3 +109,20 @@ TEST_CASE("md import: Marvelous Designer import from per-frame OBJs") {
     CHECK_THROWS_WITH_AS(import_md(opt), doctest::Contains("skirt_5.obj:1"), std::runtime_error);
   }
 }
+
+TEST_CASE("md import: frame sequences step evenly and a gap names the file") {
+  TempDir dir("md_seq");
+  auto touch = [&](const std::string& name) { write_text(dir / name, "v 0 0 0\n"); };
+  for (const char* n : {"a_0.obj", "a_5.obj", "a_10.obj", "a_15.obj"}) touch(n);
+  const std::vector<std::string> ok = list_frame_sequence(dir.path.string());
+  REQUIRE(ok.size() == 4);
+  CHECK(fs::path(ok[2]).filename() == "a_10.obj");  // natural order
+  fs::remove(dir / "a_10.obj");
+  CHECK_THROWS_WITH_AS(list_frame_sequence(dir.path.string()),
+                       doctest::Contains("a_15.obj: frame 15 follows frame 5 (step 5 before): missing frames"),
+                       std::runtime_error);
+  touch("a_10.obj");
+  touch("a_05.obj");
+  CHECK_THROWS_WITH_AS(list_frame_sequence(dir.path.string()), doctest::Contains("appears twice"),
+                       std::runtime_error);
+}
