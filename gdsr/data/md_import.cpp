@@ -52,7 +52,7 @@ void weld_sequence(std::vector<ObjData>& seq, const std::vector<int>& map, int c
 }  // namespace
 
 std::vector<std::string> list_frame_objs(const std::string& dir) {
-  if (!fs::is_directory(dir)) gdsr::fail("import-md", "no folder " + dir);
+  if (!fs::is_directory(dir)) gdsr::fail(dir, "no such folder");
   std::vector<std::pair<long, std::string>> files;
   for (const auto& e : fs::directory_iterator(dir)) {
     if (!e.is_regular_file()) continue;
@@ -61,7 +61,7 @@ std::vector<std::string> list_frame_objs(const std::string& dir) {
     if (ext != ".obj") continue;
     files.emplace_back(last_number(e.path().stem().string()), e.path().string());
   }
-  if (files.empty()) gdsr::fail("import-md", std::string(dir) + ": no .obj files");
+  if (files.empty()) gdsr::fail(dir, "no .obj files in the folder");
   std::sort(files.begin(), files.end());
   std::vector<std::string> out;
   for (auto& f : files) out.push_back(f.second);

@@ -220,5 +220,6 @@ TEST_CASE("infer cli: bad own sequences give a one-line error naming the file") 
   check_one_line_error(gdsr_run(dir, base + " --subdivide 3"), "--subdivide must be 1 or 2");
   check_one_line_error(gdsr_run(dir, "infer --model '" + ckpt + "' --lr-dir '" + (dir / "lr") + "'"), "--lr-uv");
   check_one_line_error(gdsr_run(dir, "infer --model '" + ckpt + "'"), "exactly one of --data and --lr-dir");
+  check_one_line_error(gdsr_run(dir, base + " --body-dir '" + (dir / "nobody") + "'"), "nobody: no such folder");
   CHECK_FALSE(fs::exists(out));
 }
