@@ -1,6 +1,7 @@
 #include "infer/cmd_rollout_common.hpp"
 
 #include "gdsr/cli/progress_bar.hpp"
+#include "gdsr/error.hpp"
 #include "gdsr/model/gdsr_model.hpp"
 #include "gdsr/model/model_checkpoint.hpp"
 #include "nn/checkpoint.hpp"
@@ -8,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <filesystem>
 
 namespace gdsr_cli {
 
@@ -36,8 +38,34 @@ void add_source_options(CLI::App* c, RolloutArgs& a) {
   src->require_option(1);
 }
 
+namespace {
+std::string canonical(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path p = std::filesystem::weakly_canonical(std::filesystem::absolute(path), ec);
+  return ec ? path : p.string();
+}
+}  // namespace
+
 gdsr::Prediction obtain_prediction(const RolloutArgs& a, const gdsr::Dataset& d) {
-  if (a.model.empty()) return gdsr::read_prediction(a.pred, true);
+  if (a.model.empty()) {
+    // A prediction has its own frames and dataset: both must match what is asked for.
+    if (a.opt.first_frame != 0 || a.opt.frames != -1)
+      gdsr::fail("--pred", "--first / --frames apply to --model; a prediction covers the frames it was made for");
+    gdsr::Prediction p = gdsr::read_prediction(a.pred, true);
+    if (!p.dataset.empty() && canonical(p.dataset) != canonical(a.data))
+      gdsr::fail("--pred", a.pred + " was made on the dataset " + p.dataset + ", not on " + a.data);
+    const long long T = static_cast<long long>(d.hr_frames.size());
+    if (p.G.empty()) gdsr::fail("--pred", a.pred + " holds no frames");
+    if (p.first_frame < 0 || p.first_frame + static_cast<long long>(p.G.size()) > T)
+      gdsr::fail("--pred", a.pred + " covers frames " + std::to_string(p.first_frame) + ".." +
+                               std::to_string(p.first_frame + static_cast<long long>(p.G.size()) - 1) + " but " +
+                               a.data + " has " + std::to_string(T));
+    for (size_t k = 0; k < p.G.size(); ++k)
+      if (p.G[k].rows() != d.hr.V.rows())
+        gdsr::fail("--pred", a.pred + " has " + std::to_string(p.G[k].rows()) + " HR vertices, " + a.data + " has " +
+                                 std::to_string(d.hr.V.rows()));
+    return p;
+  }
   return to_prediction(a, run_rollout(a, d));
 }
 
@@ -55,8 +83,19 @@ gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r) {
 
 void add_rollout_options(CLI::App* c, RolloutArgs& a) {
   c->add_option("--data", a.data, "dataset folder (LR input; HR for eval)")->required();
-  c->add_option("--first", a.opt.first_frame, "first frame")->capture_default_str();
-  c->add_option("--frames", a.opt.frames, "number of frames (-1: to the end)")->capture_default_str();
+  c->add_option("--first", a.opt.first_frame, "first frame")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--frames", a.opt.frames, "number of frames (-1: to the end)")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](std::string& s) {
+            int n = 0;
+            if (!CLI::detail::lexical_cast(s, n) || !(n == -1 || n >= 1))
+              return "must be at least 1 (or -1: to the end), got " + s;
+            return std::string();
+          },
+          "INT >= 1 or -1"));
   c->add_flag("--no-collisions", a.no_collisions, "skip the explicit collision handling");
 }
 
