@@ -74,7 +74,7 @@ gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r) {
   p.first_frame = r.first_frame;
   p.G = std::move(r.G);
   p.C_hat = std::move(r.C_hat);
-  p.dataset = a.data;
+  p.dataset = canonical(a.data);  // absolute: eval compares it wherever it runs
   p.model = a.model;
   p.seconds_per_frame = r.seconds_per_frame;
   p.model_seconds_per_frame = r.model_seconds_per_frame;

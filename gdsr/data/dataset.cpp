@@ -396,7 +396,13 @@ void check_dataset_out(const std::string& dir) {
     return;
   }
   // A replace killed between its two renames leaves DIR.old.<pid> and no DIR: put it back.
-  const fs::path parent = out.parent_path();
+  // The nearest existing ancestor must be a folder we may write in.
+  fs::path parent = out.parent_path();
+  fs::path anc = parent;
+  while (!anc.empty() && !fs::exists(fs::symlink_status(anc, ec)) && anc != anc.parent_path()) anc = anc.parent_path();
+  if (!fs::is_directory(anc, ec)) gdsr::fail("--out", dir + ": " + anc.string() + " is not a folder");
+  if (::access(anc.c_str(), W_OK) != 0)
+    gdsr::fail("--out", dir + ": cannot write in " + anc.string() + ": " + std::strerror(errno));
   if (!fs::is_directory(parent, ec)) return;
   const std::string prefix = name + ".old.";
   for (const auto& e : fs::directory_iterator(parent, ec)) {

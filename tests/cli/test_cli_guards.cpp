@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <unistd.h>
 
 using gdsr_test::check_one_line_error;
 using gdsr_test::gdsr_run;
@@ -32,15 +33,10 @@ int count_prefixed(const std::string& dir, const std::string& prefix) {
 // MD-style exports of the waving sheet: dir/lr, dir/hr frame folders and flattened OBJs.
 void write_exports(const TempDir& dir, int frames) {
   const gdsr::Dataset d = gdsr_test::wave_dataset(frames);
-  auto flat = [](const gdsr::GarmentMesh& g) {
-    gdsr::TriMesh m{gdsr::Points3::Zero(g.UV.rows(), 3), g.FUV};
-    m.V.leftCols(2) = g.UV;
-    return m;
-  };
   fs::create_directories(dir / "lr");
   fs::create_directories(dir / "hr");
-  gdsr::write_obj(dir / "lr_flat.obj", flat(d.lr));
-  gdsr::write_obj(dir / "hr_flat.obj", flat(d.hr));
+  gdsr::write_obj(dir / "lr_flat.obj", gdsr_test::flat_uv_mesh(d.lr));
+  gdsr::write_obj(dir / "hr_flat.obj", gdsr_test::flat_uv_mesh(d.hr));
   for (int t = 0; t < frames; ++t) {
     gdsr::write_obj(dir / ("lr/f" + std::to_string(t) + ".obj"), gdsr::TriMesh{d.lr_frames[t], d.lr.F});
     gdsr::write_obj(dir / ("hr/f" + std::to_string(t) + ".obj"), gdsr::TriMesh{d.hr_frames[t], d.hr.F});
@@ -94,6 +90,7 @@ TEST_CASE("cli guards: --out refuses a folder that is not a dataset and a regula
   CHECK(slurp(dir / "mine/notes.txt") == "my notes\n");
   CHECK(slurp(dir / "file.txt") == "a file\n");
   check_one_line_error(gdsr_run(dir, make_to("")), "--out");
+  check_one_line_error(gdsr_run(dir, make_to(dir / "file.txt/ds")), "file.txt is not a folder");
 }
 
 TEST_CASE("cli guards: import-md --out equal to or inside an input folder is refused") {
@@ -175,6 +172,23 @@ TEST_CASE("cli guards: a dataset with a huge layer id or a folder in place of a 
   fs::remove(dir / "ds2/lr_frames.bin");
   fs::create_directories(dir / "ds2/lr_frames.bin");
   check_one_line_error(gdsr_run(dir, "data check --data '" + (dir / "ds2") + "'"), "lr_frames.bin is a folder");
+}
+
+TEST_CASE("cli guards: an unreadable dataset file is reported as permission denied") {
+  TempDir dir("guard_perm");
+  gdsr::write_dataset(dir / "ds", gdsr_test::wave_dataset(3));
+  fs::permissions(dir / "ds/hr_frames.bin", fs::perms::none);
+  // root reads anything: run the binary as nobody then (setpriv, util-linux).
+  const bool root = ::geteuid() == 0;
+  if (root && std::system("command -v setpriv >/dev/null 2>&1") != 0) {
+    MESSAGE("SKIPPED: running as root without setpriv to drop privileges");
+    return;
+  }
+  if (root) fs::permissions(dir.path, fs::perms::others_read | fs::perms::others_exec, fs::perm_options::add);
+  const Run r = gdsr_run(dir, "data check --data '" + (dir / "ds") + "'",
+                         root ? "setpriv --reuid=65534 --regid=65534 --clear-groups " : "");
+  check_one_line_error(r, "hr_frames.bin: Permission denied");
+  CHECK(r.err.find("missing file") == std::string::npos);
 }
 
 TEST_CASE("cli guards: eval refuses a prediction that does not match the dataset") {
