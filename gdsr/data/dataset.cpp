@@ -219,7 +219,15 @@ Array read_array(const std::string& path, bool verify_checksum) {
   a.dtype = static_cast<DType>(dtype);
   a.dims.resize(ndim);
   for (auto& d : a.dims) take(&d, 8);
-  const uint64_t nbytes = a.count() * dtype_size(a.dtype);
+  // The element count, checked against the file size on the way: a product of dimensions
+  // that overflows 64 bits must not wrap to a small number that matches.
+  uint64_t elems = 1;
+  for (uint64_t d : a.dims) {
+    if (d != 0 && elems > s.size() / d)
+      gdsr::fail("dataset", std::string(path) + ": dimensions larger than the file (truncated or corrupt header)");
+    elems *= d;
+  }
+  const uint64_t nbytes = elems * dtype_size(a.dtype);
   if (pos + nbytes + 8 != s.size())
     gdsr::fail("dataset", std::string(path) + ": size " + std::to_string(s.size()) +
                               " bytes does not match its header (truncated or corrupt)");

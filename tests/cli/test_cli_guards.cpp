@@ -168,6 +168,16 @@ TEST_CASE("cli guards: a dataset with a huge layer id or a folder in place of a 
   gdsr::write_array(dir / "ds/hr_layer.bin", a);
   check_one_line_error(gdsr_run(dir, "data check --data '" + (dir / "ds") + "'"), "hr_layer.bin: layer id 1000000");
 
+  // Dimensions whose product wraps around 2^64 to 0 bytes (2^62 x 4 x 3 float32).
+  gdsr::write_dataset(dir / "ds3", d);
+  gdsr::Array wrap;
+  wrap.dtype = gdsr::DType::f32;
+  wrap.dims = {uint64_t(1) << 62, 4, 3};
+  gdsr::write_array(dir / "ds3/lr_frames.bin", wrap);
+  const Run rw = gdsr_run(dir, "data check --data '" + (dir / "ds3") + "'");
+  check_one_line_error(rw, "lr_frames.bin: dimensions larger than the file");
+  CHECK(rw.err.find("max_size") == std::string::npos);
+
   gdsr::write_dataset(dir / "ds2", d);
   fs::remove(dir / "ds2/lr_frames.bin");
   fs::create_directories(dir / "ds2/lr_frames.bin");
