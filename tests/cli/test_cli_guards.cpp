@@ -199,6 +199,11 @@ TEST_CASE("cli guards: an unreadable dataset file is reported as permission deni
                          root ? "setpriv --reuid=65534 --regid=65534 --clear-groups " : "");
   check_one_line_error(r, "hr_frames.bin: Permission denied");
   CHECK(r.err.find("missing file") == std::string::npos);
+  fs::permissions(dir / "ds/hr_frames.bin", fs::perms::owner_read | fs::perms::others_read);
+  fs::permissions(dir / "ds/lr.obj", fs::perms::none);
+  check_one_line_error(gdsr_run(dir, "data check --data '" + (dir / "ds") + "'",
+                                root ? "setpriv --reuid=65534 --regid=65534 --clear-groups " : ""),
+                       "lr.obj: Permission denied");
 }
 
 TEST_CASE("cli guards: eval refuses a prediction that does not match the dataset") {
