@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <filesystem>
 
 namespace gdsr_cli {
 
@@ -37,8 +38,40 @@ void add_source_options(CLI::App* c, RolloutArgs& a) {
   src->require_option(1);
 }
 
+namespace {
+std::string canonical(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path p = std::filesystem::weakly_canonical(std::filesystem::absolute(path), ec);
+  return ec ? path : p.string();
+}
+// What a prediction records as its input: the dataset folder, or "lr-dir:" and the OBJ folder
+// of an own sequence, as absolute paths (eval and export compare it wherever they run).
+std::string input_id(const RolloutArgs& a) {
+  return a.data.empty() ? "lr-dir:" + canonical(a.seq.lr_dir) : canonical(a.data);
+}
+}  // namespace
+
 gdsr::Prediction obtain_prediction(const RolloutArgs& a, const gdsr::Dataset& d) {
-  if (a.model.empty()) return gdsr::read_prediction(a.pred, true);
+  if (a.model.empty()) {
+    // A prediction has its own frames and dataset: both must match what is asked for.
+    if (a.opt.first_frame != 0 || a.opt.frames != -1)
+      gdsr::fail("--pred", "--first / --frames apply to --model; a prediction covers the frames it was made for");
+    gdsr::Prediction p = gdsr::read_prediction(a.pred, true);
+    const std::string recorded = p.dataset.rfind("lr-dir:", 0) == 0 ? p.dataset : canonical(p.dataset);
+    if (!p.dataset.empty() && recorded != input_id(a))
+      gdsr::fail("--pred", a.pred + " was made on " + p.dataset + ", not on " + input_id(a));
+    const long long T = static_cast<long long>(d.hr_frames.size());
+    if (p.G.empty()) gdsr::fail("--pred", a.pred + " holds no frames");
+    if (p.first_frame < 0 || p.first_frame + static_cast<long long>(p.G.size()) > T)
+      gdsr::fail("--pred", a.pred + " covers frames " + std::to_string(p.first_frame) + ".." +
+                               std::to_string(p.first_frame + static_cast<long long>(p.G.size()) - 1) + " but " +
+                               a.data + " has " + std::to_string(T));
+    for (size_t k = 0; k < p.G.size(); ++k)
+      if (p.G[k].rows() != d.hr.V.rows())
+        gdsr::fail("--pred", a.pred + " has " + std::to_string(p.G[k].rows()) + " HR vertices, " + a.data + " has " +
+                                 std::to_string(d.hr.V.rows()));
+    return p;
+  }
   return to_prediction(a, run_rollout(a, d));
 }
 
@@ -47,7 +80,7 @@ gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r) {
   p.first_frame = r.first_frame;
   p.G = std::move(r.G);
   p.C_hat = std::move(r.C_hat);
-  p.dataset = a.data.empty() ? "lr-dir:" + a.seq.lr_dir : a.data;
+  p.dataset = input_id(a);
   p.model = a.model;
   p.seconds_per_frame = r.seconds_per_frame;
   p.model_seconds_per_frame = r.model_seconds_per_frame;
@@ -57,8 +90,19 @@ gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r) {
 void add_rollout_options(CLI::App* c, RolloutArgs& a, bool data_required) {
   auto* data = c->add_option("--data", a.data, "dataset folder (LR input; HR for eval)");
   if (data_required) data->required();
-  c->add_option("--first", a.opt.first_frame, "first frame")->capture_default_str();
-  c->add_option("--frames", a.opt.frames, "number of frames (-1: to the end)")->capture_default_str();
+  c->add_option("--first", a.opt.first_frame, "first frame")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--frames", a.opt.frames, "number of frames (-1: to the end)")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](std::string& s) {
+            int n = 0;
+            if (!CLI::detail::lexical_cast(s, n) || !(n == -1 || n >= 1))
+              return "must be at least 1 (or -1: to the end), got " + s;
+            return std::string();
+          },
+          "INT >= 1 or -1"));
   c->add_flag("--no-collisions", a.no_collisions, "skip the explicit collision handling");
 }
 

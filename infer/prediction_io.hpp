@@ -20,10 +20,12 @@ struct Prediction {
   double seconds_per_frame = 0, model_seconds_per_frame = 0;  // wall time of the roll-out
 };
 
-// Writes the three files into dir (created if missing), each atomically.
+// Writes the three files into dir (created if missing), each atomically; prediction.json is
+// removed first and written last, so it marks a complete prediction.
 void write_prediction(const std::string& dir, const Prediction& p);
 
-// Throws gdsr::Error naming the file on a missing or malformed file.
+// Throws gdsr::Error naming the file on a missing or malformed file, arrays whose frame count
+// differs from the recorded one, or NaN / inf predicted positions.
 Prediction read_prediction(const std::string& dir, bool hr_only = false);
 
 }  // namespace gdsr

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <set>
 
@@ -191,8 +192,18 @@ void write_checkpoint(const std::string& path, const Checkpoint& ck) {
 }
 
 Checkpoint read_checkpoint(const std::string& path) {
+  {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+      throw ag::Error("checkpoint '" + path + "': is a folder, not a checkpoint file");
+  }
   std::ifstream f(path, std::ios::binary | std::ios::ate);
-  if (!f) throw ag::Error("checkpoint '" + path + "': cannot open for reading");
+  if (!f) {
+    const int err = errno;
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw ag::Error("checkpoint '" + path + "': no such file");
+    throw ag::Error("checkpoint '" + path + "': cannot open for reading: " + std::strerror(err ? err : EACCES));
+  }
   const std::streamoff size = f.tellg();
   if (size < 0) throw ag::Error("checkpoint '" + path + "': cannot determine the file size");
   f.seekg(0);

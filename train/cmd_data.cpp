@@ -22,6 +22,7 @@
 #include <chrono>
 #include <ctime>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
@@ -30,6 +31,22 @@ namespace {
 
 // Self-intersections on every k-th frame by default (see `data check --help`).
 constexpr int kDefaultIntersectionStride = 1;
+// Sane bounds of `data make` (metres, frames per second, pixels).
+constexpr double kMinParticleDistance = 0.002, kMaxParticleDistance = 0.5;
+constexpr double kMaxFps = 240;
+constexpr int kMinRaster = 8, kMaxRaster = 8192;
+
+// CLI::Range lets NaN through (every comparison is false); this one does not.
+CLI::Validator finite_range(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& s) {
+        double x = NAN;
+        if (!CLI::detail::lexical_cast(s, x) || !(x >= lo && x <= hi))
+          return "value " + s + " not in range [" + std::to_string(lo) + " - " + std::to_string(hi) + "]";
+        return std::string();
+      },
+      "FLOAT in [" + std::to_string(lo) + " - " + std::to_string(hi) + "]");
+}
 
 struct MakeArgs {
   std::string garment = "skirt_short";
@@ -109,8 +126,11 @@ gdsr::ValidityFigures measure(const gdsr::Dataset& d, const gdsr::ValidityOption
 }
 
 void run_make(const MakeArgs& a) {
-  if (a.out.empty()) gdsr::fail("data make", "--out is required");
-  if (!(a.lr_pd > 0) || !(a.hr_pd > 0)) gdsr::fail("data make", "particle distances must be positive");
+  // Everything that can be refused is refused here, before minutes of simulation.
+  gdsr::check_dataset_out(a.out);
+  if (!(a.hr_pd <= a.lr_pd))
+    gdsr::fail("--hr-pd", "the HR particle distance " + std::to_string(a.hr_pd) +
+                              " m is coarser than the LR one (--lr-pd " + std::to_string(a.lr_pd) + " m)");
   gdsr::BodyOptions bo;
   bo.fps = a.fps;
   bo.rest_blend_frames = a.rest_blend_frames;
@@ -279,7 +299,25 @@ struct ImportArgs {
   std::string out;
 };
 
+// True if `inner` is `outer` or inside it (absolute, normalised, symlinks resolved as far as
+// they exist).
+bool is_within(const std::string& inner, const std::string& outer) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path i = fs::weakly_canonical(fs::absolute(inner), ec), o = fs::weakly_canonical(fs::absolute(outer), ec);
+  auto ii = i.begin();
+  for (auto oi = o.begin(); oi != o.end(); ++oi, ++ii) {
+    if (oi->empty()) continue;  // trailing "/"
+    if (ii == i.end() || *ii != *oi) return false;
+  }
+  return true;
+}
+
 void run_import(const ImportArgs& a) {
+  gdsr::check_dataset_out(a.out);
+  for (const std::string* in : {&a.opt.lr_dir, &a.opt.hr_dir, &a.opt.body_dir, &a.opt.lr_uv, &a.opt.hr_uv})
+    if (!in->empty() && (is_within(a.out, *in) || is_within(*in, a.out)))
+      gdsr::fail("--out", a.out + " overlaps the input " + *in + "; write the dataset somewhere else");
   gdsr::MdImportOptions opt = a.opt;
   gdsr::ProgressBar bar("import");
   opt.progress = bar.callback();
@@ -373,25 +411,38 @@ void add_data_command(CLI::App& app) {
       ->check(CLI::IsMember(sim::garment_names()));
   make->add_option("--motion", mk->motion, "motion file (BVH, FBX, glTF, Collada)")->capture_default_str();
   make->add_option("--out", mk->out, "dataset folder to write (atomically)")->required();
-  make->add_option("--lr-pd", mk->lr_pd, "LR particle distance, metres")->capture_default_str();
-  make->add_option("--hr-pd", mk->hr_pd, "HR particle distance, metres")->capture_default_str();
-  make->add_option("--seconds", mk->seconds, "clip length in seconds (after the rest blend)")->capture_default_str();
-  make->add_option("--start", mk->start, "clip start in seconds")->capture_default_str();
-  make->add_option("--fps", mk->fps, "frames per second")->capture_default_str();
-  make->add_option("--substeps", mk->substeps, "solver substeps per frame (default: the solver's)");
+  // Bounds keep a run finite: a finer particle distance or a higher frame rate than these
+  // would simulate for hours (vertex count grows as 1/pd^2).
+  make->add_option("--lr-pd", mk->lr_pd, "LR particle distance, metres")
+      ->capture_default_str()
+      ->check(finite_range(kMinParticleDistance, kMaxParticleDistance));
+  make->add_option("--hr-pd", mk->hr_pd, "HR particle distance, metres (not coarser than --lr-pd)")
+      ->capture_default_str()
+      ->check(finite_range(kMinParticleDistance, kMaxParticleDistance));
+  make->add_option("--seconds", mk->seconds, "clip length in seconds (after the rest blend)")
+      ->capture_default_str()
+      ->check(finite_range(1e-3, 3600.0));
+  make->add_option("--start", mk->start, "clip start in seconds")->capture_default_str()->check(finite_range(0.0, 1e6));
+  make->add_option("--fps", mk->fps, "frames per second")->capture_default_str()->check(finite_range(1.0, kMaxFps));
+  make->add_option("--substeps", mk->substeps, "solver substeps per frame (default: the solver's)")
+      ->check(CLI::Range(1, 1000));
   make->add_option("--iterations", mk->iterations, "constraint passes per substep (default: the solver's)")
       ->check(CLI::Range(1, 100));
   make->add_option("--stretch-passes", mk->stretch_passes, "stretch passes per iteration (default: the solver's)")
       ->check(CLI::Range(1, 100));
   make->add_option("--friction", mk->friction, "Coulomb friction against the body (default: the solver's)")
-      ->check(CLI::Range(0.0, 2.0));
+      ->check(finite_range(0.0, 2.0));
   make->add_option("--bend-stiffness", mk->bend_stiffness, "bending modulus, N m (default: the solver's)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(finite_range(0.0, 1.0));
   make->add_option("--self-thickness", mk->self_thickness, "cloth-cloth distance kept, metres (default: the solver's)")
-      ->check(CLI::Range(0.0, 0.05));
+      ->check(finite_range(0.0, 0.05));
   make->add_flag("!--no-self-collision", mk->self_collision, "switch cloth self-collision off");
-  make->add_option("--rest-blend", mk->rest_blend_frames, "frames blending from the rest pose")->capture_default_str();
-  make->add_option("--raster", mk->raster, "UV raster size in pixels")->capture_default_str();
+  make->add_option("--rest-blend", mk->rest_blend_frames, "frames blending from the rest pose")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
+  make->add_option("--raster", mk->raster, "UV raster size in pixels")
+      ->capture_default_str()
+      ->check(CLI::Range(kMinRaster, kMaxRaster));
   make->add_option("--intersection-stride", mk->intersection_stride, "count self-intersections on every k-th frame")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -415,8 +466,12 @@ void add_data_command(CLI::App& app) {
   im->add_option("--hr-uv", imp->opt.hr_uv, "flattened (UV) HR OBJ")->required();
   im->add_option("--body-dir", imp->opt.body_dir, "folder of per-frame body OBJs (optional)");
   im->add_option("--garment", imp->opt.garment, "garment name")->capture_default_str();
-  im->add_option("--fps", imp->opt.fps, "frames per second of the exports")->capture_default_str();
-  im->add_option("--scale", imp->opt.scale, "file units to metres (0.001 for mm)")->capture_default_str();
+  im->add_option("--fps", imp->opt.fps, "frames per second of the exports")
+      ->capture_default_str()
+      ->check(finite_range(1.0, kMaxFps));
+  im->add_option("--scale", imp->opt.scale, "file units to metres (0.001 for mm)")
+      ->capture_default_str()
+      ->check(finite_range(1e-6, 1e6));
   im->add_option("--weld", imp->opt.weld, "merge 3-D vertices closer than this (metres) for unwelded exports");
   im->add_option("--out", imp->out, "dataset folder to write")->required();
   im->callback([imp]() { run_import(*imp); });

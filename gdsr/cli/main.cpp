@@ -7,11 +7,17 @@
 
 #include <exception>
 #include <iostream>
+#include <new>
+#include <stdexcept>
 #include <string>
 
 namespace {
 int fail(const std::string& msg) {
   std::string line = msg;
+  // nlohmann-json prefixes its messages with "[json.exception.<kind>.<id>] ": not for users.
+  const size_t j = line.find("[json.exception");
+  if (j != std::string::npos && line.find("] ", j) != std::string::npos)
+    line = line.substr(0, j) + "bad JSON: " + line.substr(line.find("] ", j) + 2);
   for (char& c : line)
     if (c == '\n' || c == '\r') c = ' ';
   std::cerr << "gdsr: error: " << line << "\n";
@@ -38,6 +44,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
     return fail(e.what());
+  } catch (const std::bad_alloc&) {
+    return fail("out of memory: a size in an input file or a flag is too large for this machine");
+  } catch (const std::length_error&) {
+    return fail("a size in an input file or a flag is too large (beyond what a container can hold)");
   } catch (const std::exception& e) {
     return fail(e.what());
   }

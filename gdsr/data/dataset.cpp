@@ -6,18 +6,31 @@
 
 #include "gdsr/geometry/obj_io.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <unistd.h>
 
 namespace gdsr {
 namespace fs = std::filesystem;
 namespace {
 
+constexpr int kMaxLayers = 64;
 constexpr char kMagic[8] = {'G', 'D', 'S', 'R', 'A', 'R', 'R', '1'};
+
+// Why `path` did not open: missing, a folder, or the system's reason (permission denied, ...).
+[[noreturn]] void fail_to_open(const std::string& path) {
+  const int err = errno;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) gdsr::fail("dataset", "missing file " + path);
+  if (fs::is_directory(path, ec)) gdsr::fail("dataset", path + " is a folder, not a file");
+  gdsr::fail("dataset", "cannot read " + path + ": " + std::strerror(err ? err : EACCES));
+}
 
 size_t dtype_size(DType t) { return t == DType::f64 ? 8 : 4; }
 
@@ -183,7 +196,7 @@ void write_array(const std::string& path, const Array& a) {
 
 Array read_array(const std::string& path, bool verify_checksum) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) gdsr::fail("dataset", "missing file " + path);
+  if (!in || fs::is_directory(path)) fail_to_open(path);
   std::ostringstream ss;
   ss << in.rdbuf();
   const std::string s = ss.str();
@@ -206,7 +219,15 @@ Array read_array(const std::string& path, bool verify_checksum) {
   a.dtype = static_cast<DType>(dtype);
   a.dims.resize(ndim);
   for (auto& d : a.dims) take(&d, 8);
-  const uint64_t nbytes = a.count() * dtype_size(a.dtype);
+  // The element count, checked against the file size on the way: a product of dimensions
+  // that overflows 64 bits must not wrap to a small number that matches.
+  uint64_t elems = 1;
+  for (uint64_t d : a.dims) {
+    if (d != 0 && elems > s.size() / d)
+      gdsr::fail("dataset", std::string(path) + ": dimensions larger than the file (truncated or corrupt header)");
+    elems *= d;
+  }
+  const uint64_t nbytes = elems * dtype_size(a.dtype);
   if (pos + nbytes + 8 != s.size())
     gdsr::fail("dataset", std::string(path) + ": size " + std::to_string(s.size()) +
                               " bytes does not match its header (truncated or corrupt)");
@@ -315,7 +336,7 @@ void validate_dataset(const Dataset& d, const std::string& where) {
 
 DatasetManifest read_manifest(const std::string& path) {
   std::ifstream in(path);
-  if (!in) gdsr::fail("dataset", "missing file " + path);
+  if (!in || fs::is_directory(path)) fail_to_open(path);
   nlohmann::json j;
   try {
     in >> j;
@@ -355,12 +376,62 @@ DatasetManifest read_manifest(const std::string& path) {
 
 // ---------------------------------------------------------------- write / load
 
+namespace {
+
+fs::path absolute_out(const std::string& dir) {
+  if (dir.empty()) gdsr::fail("--out", "empty output folder name");
+  fs::path p = fs::absolute(fs::path(dir)).lexically_normal();
+  if (p.filename().empty()) p = p.parent_path();  // "DIR/" names DIR
+  if (dir.empty() || p.filename().empty() || p.filename() == "." || p.filename() == "..")
+    gdsr::fail("--out", "bad output folder '" + dir + "'");
+  return p;
+}
+
+std::string pid_suffix() { return std::to_string(static_cast<long>(::getpid())); }
+
+}  // namespace
+
+void check_dataset_out(const std::string& dir) {
+  const fs::path out = absolute_out(dir);
+  const std::string name = out.filename().string();
+  std::error_code ec;
+  const fs::file_status st = fs::symlink_status(out, ec);
+  if (fs::exists(st)) {
+    if (!fs::is_directory(fs::status(out, ec)))
+      gdsr::fail("--out", dir + " exists and is not a folder; refusing to replace it");
+    if (!fs::exists(out / "manifest.json", ec))
+      gdsr::fail("--out", dir + " exists and is not a gdsr dataset (no manifest.json); refusing to replace it");
+    return;
+  }
+  // A replace killed between its two renames leaves DIR.old.<pid> and no DIR: put it back.
+  // The nearest existing ancestor must be a folder we may write in.
+  fs::path parent = out.parent_path();
+  fs::path anc = parent;
+  while (!anc.empty() && !fs::exists(fs::symlink_status(anc, ec)) && anc != anc.parent_path()) anc = anc.parent_path();
+  if (!fs::is_directory(anc, ec)) gdsr::fail("--out", dir + ": " + anc.string() + " is not a folder");
+  if (::access(anc.c_str(), W_OK) != 0)
+    gdsr::fail("--out", dir + ": cannot write in " + anc.string() + ": " + std::strerror(errno));
+  if (!fs::is_directory(parent, ec)) return;
+  const std::string prefix = name + ".old.";
+  for (const auto& e : fs::directory_iterator(parent, ec)) {
+    const std::string n = e.path().filename().string();
+    if (n.rfind(prefix, 0) != 0 || !fs::exists(e.path() / "manifest.json")) continue;
+    fs::rename(e.path(), out, ec);
+    if (ec)
+      gdsr::fail("--out", "found " + e.path().string() + " from an interrupted replace of " + dir +
+                              " and cannot restore it: " + ec.message());
+    std::fprintf(stderr, "gdsr: note: restored %s from %s (an earlier replace was interrupted)\n", dir.c_str(),
+                 e.path().string().c_str());
+    return;
+  }
+}
+
 void write_dataset(const std::string& dir, const Dataset& d) {
   validate_dataset(d, dir);
-  const fs::path final_dir = fs::absolute(fs::path(dir)).lexically_normal();
+  check_dataset_out(dir);
+  const fs::path final_dir = absolute_out(dir);
   const std::string name = final_dir.filename().string();
-  if (name.empty()) gdsr::fail("dataset", "bad output folder '" + dir + "'");
-  const fs::path tmp = final_dir.parent_path() / (name + ".tmp");
+  const fs::path tmp = final_dir.parent_path() / (name + ".tmp." + pid_suffix());
   std::error_code ec;
   fs::remove_all(tmp, ec);
   fs::create_directories(tmp, ec);
@@ -397,8 +468,8 @@ void write_dataset(const std::string& dir, const Dataset& d) {
       join(t, "uv_raster_bary.bin"),
       make_array(DType::f32, {static_cast<uint64_t>(r.height), static_cast<uint64_t>(r.width), 3}, r.bary.data()));
 
-  // Swap in: an existing folder is moved aside first, removed after the rename succeeds.
-  const fs::path old = final_dir.parent_path() / (name + ".old");
+  // Swap in: an existing dataset is moved aside first, removed after the rename succeeds.
+  const fs::path old = final_dir.parent_path() / (name + ".old." + pid_suffix());
   fs::remove_all(old, ec);
   const bool had = fs::exists(final_dir);
   if (had) {
@@ -406,7 +477,11 @@ void write_dataset(const std::string& dir, const Dataset& d) {
     if (ec) gdsr::fail("dataset", "cannot move the existing " + final_dir.string() + " aside: " + ec.message());
   }
   fs::rename(tmp, final_dir, ec);
-  if (ec) gdsr::fail("dataset", "cannot rename " + tmp.string() + " to " + final_dir.string() + ": " + ec.message());
+  if (ec) {
+    const std::string why = ec.message();
+    if (had) fs::rename(old, final_dir, ec);  // put the old dataset back
+    gdsr::fail("dataset", "cannot rename " + tmp.string() + " to " + final_dir.string() + ": " + why);
+  }
   if (had) fs::remove_all(old, ec);
 }
 
@@ -426,8 +501,14 @@ Dataset load_dataset(const std::string& dir, const LoadOptions& opt) {
     const Array a = read_array(join(dir, name), v);
     expect_shape(a, DType::i32, {static_cast<uint64_t>(g.V.rows())}, join(dir, name));
     g.layer = to_ints(a);
-    for (int l : g.layer)
+    for (int l : g.layer) {
       if (l < 0) gdsr::fail("dataset", join(dir, name) + ": negative layer id");
+      // Layer ids count the cloth layers (a handful); a huge one would make every per-layer
+      // loop run for ever.
+      if (l >= kMaxLayers)
+        gdsr::fail("dataset", join(dir, name) + ": layer id " + std::to_string(l) + " out of range (at most " +
+                                  std::to_string(kMaxLayers) + " layers)");
+    }
   };
   read_layer(d.lr, "lr_layer.bin");
   read_layer(d.hr, "hr_layer.bin");

@@ -61,7 +61,16 @@ void validate_dataset(const Dataset& d, const std::string& where);
 // Throws if a UV triangle has (near) zero area or collinear corners, or an index is bad.
 void check_uv_layout(const GarmentMesh& g, const std::string& what);
 
-// Writes the folder `dir` atomically: everything goes to dir + ".tmp", then replaces dir.
+// Checks that `dir` may be written as a dataset folder, before any work is done: it does not
+// exist, or it is a gdsr dataset (has manifest.json). An existing regular file or a folder
+// that is not a dataset is refused (never deleted). A leftover dir + ".old.<pid>" from a
+// replace that was killed between its renames, with no `dir`, is renamed back to `dir` (a note
+// on stderr says so).
+void check_dataset_out(const std::string& dir);
+
+// Writes the folder `dir` atomically: everything goes to dir + ".tmp.<pid>"; an existing
+// dataset is moved to dir + ".old.<pid>", the new one renamed in, then the old one removed
+// (see check_dataset_out for a kill between the renames).
 void write_dataset(const std::string& dir, const Dataset& d);
 
 struct LoadOptions {

@@ -3,9 +3,11 @@
 #include "gdsr/error.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -21,7 +23,7 @@ namespace {
 
 std::string read_all(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) gdsr::fail("obj", "cannot open " + path);
+  if (!in) gdsr::fail("obj", "cannot open " + path + ": " + std::strerror(errno));  // missing, permission, ...
   std::ostringstream ss;
   ss << in.rdbuf();
   return ss.str();

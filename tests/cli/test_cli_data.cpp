@@ -25,15 +25,10 @@ namespace {
 void write_md_exports(const TempDir& dir, int lr_frames, int hr_frames) {
   const gdsr::GarmentMesh lr = gdsr_test::grid_garment(gdsr_test::GridSpec(6, 3, 0.6, 0.3).tube());
   const gdsr::GarmentMesh hr = gdsr::subdivide_midpoint(lr);
-  auto flat = [](const gdsr::GarmentMesh& g) {
-    gdsr::TriMesh m{gdsr::Points3::Zero(g.UV.rows(), 3), g.FUV};
-    m.V.leftCols(2) = g.UV;
-    return m;
-  };
   fs::create_directories(dir / "lr");
   fs::create_directories(dir / "hr");
-  gdsr::write_obj(dir / "lr_flat.obj", flat(lr));
-  gdsr::write_obj(dir / "hr_flat.obj", flat(hr));
+  gdsr::write_obj(dir / "lr_flat.obj", gdsr_test::flat_uv_mesh(lr));
+  gdsr::write_obj(dir / "hr_flat.obj", gdsr_test::flat_uv_mesh(hr));
   for (int t = 0; t < lr_frames; ++t)
     gdsr::write_obj(dir / ("lr/f" + std::to_string(t) + ".obj"), gdsr::TriMesh{lr.V, lr.F});
   for (int t = 0; t < hr_frames; ++t)

@@ -26,9 +26,11 @@ inline std::string slurp(const std::string& path) {
   return ss.str();
 }
 
-inline Run gdsr_run(const TempDir& dir, const std::string& args) {
+// `prefix` runs before the binary (e.g. a command that drops privileges).
+inline Run gdsr_run(const TempDir& dir, const std::string& args, const std::string& prefix = "") {
   const std::string out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd = std::string("'") + GDSR_BINARY_DIR + "/gdsr' " + args + " >'" + out + "' 2>'" + err + "'";
+  const std::string cmd =
+      prefix + std::string("'") + GDSR_BINARY_DIR + "/gdsr' " + args + " >'" + out + "' 2>'" + err + "'";
   const int rc = std::system(cmd.c_str());
   Run r;
   r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;

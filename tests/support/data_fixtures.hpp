@@ -29,6 +29,13 @@ struct TempDir {
   std::string operator/(const std::string& name) const { return (path / name).string(); }
 };
 
+// The UV layout of g as a flat mesh (z = 0), as Marvelous Designer exports the pattern.
+inline gdsr::TriMesh flat_uv_mesh(const gdsr::GarmentMesh& g) {
+  gdsr::TriMesh m{gdsr::Points3::Zero(g.UV.rows(), 3), g.FUV};
+  m.V.leftCols(2) = g.UV;
+  return m;
+}
+
 // A 4x4-quad LR sheet and an 8x8-quad HR sheet of the same UV outline (0.3 m square),
 // waving over `frames` frames, the HR one with finer ripples; no body.
 inline gdsr::Dataset wave_dataset(int frames = 8) {
