@@ -41,8 +41,11 @@ void add_source_options(CLI::App* c, RolloutArgs& a) {
 namespace {
 std::string canonical(const std::string& path) {
   std::error_code ec;
-  const std::filesystem::path p = std::filesystem::weakly_canonical(std::filesystem::absolute(path), ec);
-  return ec ? path : p.string();
+  if (path.empty()) return path;
+  const std::filesystem::path abs = std::filesystem::absolute(path, ec);
+  if (ec) return path;
+  const std::filesystem::path p = std::filesystem::weakly_canonical(abs, ec);
+  return ec ? abs.string() : p.string();
 }
 // What a prediction records as its input: the dataset folder, or "lr-dir:" and the OBJ folder
 // of an own sequence, as absolute paths (eval and export compare it wherever they run).
@@ -57,10 +60,10 @@ gdsr::Prediction obtain_prediction(const RolloutArgs& a, const gdsr::Dataset& d)
     if (a.opt.first_frame != 0 || a.opt.frames != -1)
       gdsr::fail("--pred", "--first / --frames apply to --model; a prediction covers the frames it was made for");
     gdsr::Prediction p = gdsr::read_prediction(a.pred, true);
-    const std::string recorded = p.dataset.rfind("lr-dir:", 0) == 0 ? p.dataset : canonical(p.dataset);
-    if (!p.dataset.empty() && recorded != input_id(a))
+    if (!p.dataset.empty() &&
+        (p.dataset.rfind("lr-dir:", 0) == 0 ? p.dataset : canonical(p.dataset)) != input_id(a))
       gdsr::fail("--pred", a.pred + " was made on " + p.dataset + ", not on " + input_id(a));
-    const long long T = static_cast<long long>(d.hr_frames.size());
+    const long long T = static_cast<long long>(d.lr_frames.size());  // an own sequence has no HR frames
     if (p.G.empty()) gdsr::fail("--pred", a.pred + " holds no frames");
     if (p.first_frame < 0 || p.first_frame + static_cast<long long>(p.G.size()) > T)
       gdsr::fail("--pred", a.pred + " covers frames " + std::to_string(p.first_frame) + ".." +

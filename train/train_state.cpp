@@ -36,6 +36,7 @@ nlohmann::json progress_to_json(const TrainProgress& p) {
   j["noise_has_spare"] = p.noise.has_spare;
   j["frames_per_step"] = p.frames_per_step;
   j["frames_per_epoch"] = p.frames_per_epoch;
+  j["data"] = p.data;
   j["has_best"] = p.has_best;
   j["best_bits"] = bits(p.best);
   j["interval_sum_bits"] = bits(p.interval_sum);
@@ -58,6 +59,7 @@ TrainProgress progress_from_json(const nlohmann::json& j, const std::string& pat
     p.noise.has_spare = j.at("noise_has_spare").get<bool>();
     p.frames_per_step = j.at("frames_per_step").get<int>();
     p.frames_per_epoch = j.at("frames_per_epoch").get<int64_t>();
+    p.data = j.at("data").get<std::vector<std::string>>();
     p.has_best = j.at("has_best").get<bool>();
     p.best = from_bits(j.at("best_bits").get<uint64_t>());
     p.interval_sum = from_bits(j.at("interval_sum_bits").get<uint64_t>());

@@ -24,6 +24,9 @@ struct TrainProgress {
   nn::Rng::State noise{};                  // the training noise stream
   int frames_per_step = 1;
   int64_t frames_per_epoch = 0;
+  // One line per training sequence, "garment LR-vertices/HR-vertices frames": a resume on other
+  // data (another garment with the same frame count included) is refused.
+  std::vector<std::string> data;
   bool has_best = false;
   double best = 0;           // figure of the best checkpoint so far
   double interval_sum = 0;   // training totals since the last checkpoint

@@ -77,6 +77,7 @@ void check_weight(const std::string& name, double w) {
 
 // The state of the RNGs and the data position from a checkpoint written by this trainer.
 void restore_progress(TrainState& s, const nn::Checkpoint& ck, const std::string& path, const TrainOptions& opt) {
+  const std::vector<std::string> given = s.p.data;
   nlohmann::json meta;
   try {
     meta = nlohmann::json::parse(ck.metadata);
@@ -87,6 +88,12 @@ void restore_progress(TrainState& s, const nn::Checkpoint& ck, const std::string
     gdsr::fail(path, "holds no training state (data order, RNGs), so it cannot be resumed exactly");
   s.p = progress_from_json(meta["trainer"], path);
   if (s.p.step != ck.step) gdsr::fail(path, "training state is at another step than the checkpoint");
+  for (size_t i = 0; i < std::max(given.size(), s.p.data.size()); ++i) {
+    const std::string was = i < s.p.data.size() ? s.p.data[i] : "nothing", now = i < given.size() ? given[i] : "nothing";
+    if (was != now)
+      gdsr::fail(path, "was trained on other data: sequence " + std::to_string(i + 1) + " was '" + was +
+                           "' (garment LR/HR vertices frames), the data given is '" + now + "'");
+  }
   if (s.p.frames_per_epoch != static_cast<int64_t>(s.frames.size()))
     gdsr::fail(path, "was trained on " + std::to_string(s.p.frames_per_epoch) + " frames per epoch, the data given has " +
                          std::to_string(s.frames.size()));
@@ -119,6 +126,9 @@ void start_training(TrainState& s, const std::vector<const Dataset*>& data, cons
   s.adam = std::make_unique<nn::AdamW<float>>(s.model->named_parameters(), ao);
   s.p.frames_per_step = opt.frames_per_step * opt.ranks;
   s.p.frames_per_epoch = static_cast<int64_t>(s.frames.size());
+  for (const Dataset* d : data)
+    s.p.data.push_back(d->manifest.garment + " " + std::to_string(d->lr.V.rows()) + "/" +
+                       std::to_string(d->hr.V.rows()) + " " + std::to_string(d->lr_frames.size()));
   s.rng.seed(opt.seed);
   s.noise = nn::Rng(opt.seed * 7919 + 1);
   if (!opt.resume.empty()) {

@@ -36,6 +36,7 @@ TEST_CASE("cli export: glTF PC2 and OBJ of the three sequences") {
   write_inputs(dir);
   const Run r = gdsr_run(dir, "export --pred '" + (dir / "pred") + "' --data '" + (dir / "ds") + "' --out '" +
                                   (dir / "exp") + "' --obj-every 3");
+  CAPTURE(r.err);
   REQUIRE(r.status == 0);
   CHECK(r.out.find("frames 2..5") != std::string::npos);
   for (const char* f : {"export.json", "gdsr.gltf", "gdsr.bin", "gdsr.pc2", "gdsr_rest.obj", "lr.gltf", "hr.pc2",
@@ -65,6 +66,7 @@ TEST_CASE("cli eval: --report writes tables plots images video and exports") {
   write_inputs(dir);
   const Run r = gdsr_run(dir, "eval --pred '" + (dir / "pred") + "' --data '" + (dir / "ds") + "' --report '" +
                                   (dir / "rep") + "' --report-steps 1,4");
+  CAPTURE(r.err);
   REQUIRE(r.status == 0);
   CHECK(r.out.find("evaluation over 4 frames") != std::string::npos);
   CHECK(r.out.find("wrote report") != std::string::npos);

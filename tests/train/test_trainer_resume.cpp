@@ -130,10 +130,14 @@ TEST_CASE("trainer: a corrupt or foreign resume checkpoint is refused naming the
   o.resume = dir / "model_only.ckpt";
   CHECK_THROWS_WITH_AS(gdsr::train_gdsr({&d}, o), doctest::Contains("optimizer state"), std::runtime_error);
 
-  // Another dataset: the stored epoch order does not fit.
+  // Another dataset: a longer clip, and another garment with the same frame count.
   const gdsr::Dataset longer = gdsr_test::wave_dataset(10);
   o.resume = dir / "model.ckpt";
-  CHECK_THROWS_WITH_AS(gdsr::train_gdsr({&longer}, o), doctest::Contains("6 frames per epoch"), std::runtime_error);
+  CHECK_THROWS_WITH_AS(gdsr::train_gdsr({&longer}, o), doctest::Contains("was trained on other data"),
+                       std::runtime_error);
+  gdsr::Dataset other = gdsr_test::wave_dataset();
+  other.manifest.garment = "another_garment";
+  CHECK_THROWS_WITH_AS(gdsr::train_gdsr({&other}, o), doctest::Contains("another_garment"), std::runtime_error);
 
   // Already at the end: nothing is trained and nothing is overwritten.
   o.max_steps = 2;
