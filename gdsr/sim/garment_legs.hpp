@@ -5,9 +5,12 @@
 #pragma once
 
 #include "gdsr/geometry/mesh.hpp"
+#include "gdsr/sim/pattern.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 namespace sim {
 
@@ -41,6 +44,22 @@ inline LegCoords leg_coords(int panel, const gdsr::Vec2& uv, double W, double R,
   const double u = std::clamp((y - Hc) / blend, 0.0, 1.0);
   c.blend = u * u * (3 - 2 * u);
   return c;
+}
+
+// The two panels `prefix`_front and `prefix`_back (laid W + 0.1 apart, as leg_coords
+// expects): width W, height Htot, crotch Hc above the hem, gusset half-width g at the hem;
+// side seams and inseams.
+inline void add_two_leg_panels(Pattern& p, double W, double Htot, double Hc, double g, const std::string& prefix) {
+  std::vector<gdsr::Vec2> o{gdsr::Vec2(-W / 2, 0), gdsr::Vec2(-g, 0),       gdsr::Vec2(0, Hc),
+                            gdsr::Vec2(g, 0),      gdsr::Vec2(W / 2, 0),    gdsr::Vec2(W / 2, Htot),
+                            gdsr::Vec2(-W / 2, Htot)};
+  p.panels.push_back({prefix + "_front", o});
+  for (auto& v : o) v.x() += W + 0.1;
+  p.panels.push_back({prefix + "_back", o});
+  p.seams.push_back({0, 4, 1, 6, true});  // side seams
+  p.seams.push_back({1, 4, 0, 6, true});
+  p.seams.push_back({0, 1, 1, 2, true});  // inseams
+  p.seams.push_back({0, 2, 1, 1, true});
 }
 
 }  // namespace sim

@@ -31,15 +31,7 @@ GarmentDesign design_pants(const BodyLandmarks& lm) {
   const double Hc = lm.crotch_y - 0.03 * s - hem_y;
   const double r_hem = 0.075 * s;
   const double g = std::max(0.02 * s, W / 2 - kPi * r_hem), blend = 0.10 * s;
-  std::vector<Vec2> o{Vec2(-W / 2, 0), Vec2(-g, 0),       Vec2(0, Hc),       Vec2(g, 0),
-                      Vec2(W / 2, 0),  Vec2(W / 2, Htot), Vec2(-W / 2, Htot)};
-  p.panels.push_back({"pants_front", o});
-  for (auto& v : o) v.x() += W + 0.1;
-  p.panels.push_back({"pants_back", o});
-  p.seams.push_back({0, 4, 1, 6, true});  // side seams
-  p.seams.push_back({1, 4, 0, 6, true});
-  p.seams.push_back({0, 1, 1, 2, true});  // inseams
-  p.seams.push_back({0, 2, 1, 1, true});
+  add_two_leg_panels(p, W, Htot, Hc, g, "pants");
   // Each leg tube is a tilted cone around the body leg's line (from `top` at the crotch
   // height, R/2 to the side, to the leg's centre near the ankle); below the top quarter its
   // cross-sections are perpendicular to that line (e1 outwards, e2 forwards), so the

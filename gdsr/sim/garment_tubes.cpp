@@ -97,15 +97,7 @@ GarmentDesign design_shorts(const BodyLandmarks& lm) {
   const double Htot = lm.waist_y - hem_y;
   const double Hc = lm.crotch_y - 0.03 * s - hem_y;
   const double g = 0.02 * s, blend = 0.10 * s;
-  std::vector<Vec2> o{Vec2(-W / 2, 0), Vec2(-g, 0),       Vec2(0, Hc),       Vec2(g, 0),
-                      Vec2(W / 2, 0),  Vec2(W / 2, Htot), Vec2(-W / 2, Htot)};
-  Panel front{"shorts_front", o};
-  p.panels.push_back(front);
-  p.panels.push_back(mirror_copy(front, W + 0.1, "shorts_back"));
-  p.seams.push_back({0, 4, 1, 6, true});  // side seams
-  p.seams.push_back({1, 4, 0, 6, true});
-  p.seams.push_back({0, 1, 1, 2, true});  // inseams
-  p.seams.push_back({0, 2, 1, 1, true});
+  add_two_leg_panels(p, W, Htot, Hc, g, "shorts");
   d.place = [=](int panel, const Vec2& uv) {
     // Between the crotch and crotch + blend the tubes blend into the hip cylinder, so the
     // crotch point sits between the legs.
