@@ -58,8 +58,8 @@ struct MakeArgs {
   double fps = 30;
   int substeps = -1;  // <0: the solver's default
   // Solver knobs (NaN / <0: the solver's default, sim::SimParams).
-  int iterations = -1, stretch_passes = -1;
-  double friction = NAN, bend_stiffness = NAN, self_thickness = NAN;
+  int iterations = -1, stretch_passes = -1, settle_frames = -1;
+  double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN;
   bool self_collision = true;
   int rest_blend_frames = 15;
   int raster = 1024;
@@ -147,9 +147,11 @@ void run_make(const MakeArgs& a) {
   if (a.substeps > 0) params.substeps = a.substeps;
   if (a.iterations > 0) params.iterations = a.iterations;
   if (a.stretch_passes > 0) params.stretch_passes = a.stretch_passes;
+  if (a.settle_frames >= 0) params.settle_frames = a.settle_frames;
   if (!std::isnan(a.friction)) params.friction = a.friction;
   if (!std::isnan(a.bend_stiffness)) params.bend_stiffness = a.bend_stiffness;
   if (!std::isnan(a.self_thickness)) params.self_thickness = a.self_thickness;
+  if (!std::isnan(a.compression_ratio)) params.compression_ratio = a.compression_ratio;
   params.self_collision = a.self_collision;
   const SimRun lr = simulate_one(a, a.lr_pd, "LR", body, params);
   const SimRun hr = simulate_one(a, a.hr_pd, "HR", body, params);
@@ -184,8 +186,10 @@ void run_make(const MakeArgs& a) {
                   {"bend_stiffness_n_m", params.bend_stiffness},
                   {"damping_1_s", params.damping},
                   {"settle_frames", params.settle_frames},
+                  {"settle_damping_1_s", params.settle_damping},
                   {"self_collision", params.self_collision},
                   {"self_thickness_m", params.self_thickness},
+                  {"compression_ratio", params.compression_ratio},
                   {"clip_start_s", a.start},
                   {"clip_seconds", a.seconds}};
   gdsr::update_manifest_counts(d);
@@ -436,6 +440,12 @@ void add_data_command(CLI::App& app) {
       ->check(finite_range(0.0, 1.0));
   make->add_option("--self-thickness", mk->self_thickness, "cloth-cloth distance kept, metres (default: the solver's)")
       ->check(finite_range(0.0, 0.05));
+  make->add_option("--compression-ratio", mk->compression_ratio,
+                   "in-plane compression stiffness / stretch stiffness (default: the solver's)")
+      ->check(finite_range(1e-4, 1.0));
+  make->add_option("--settle-frames", mk->settle_frames,
+                   "frames of damped motion on the first pose before frame 0 (default: the solver's)")
+      ->check(CLI::Range(0, 1000));
   make->add_flag("!--no-self-collision", mk->self_collision, "switch cloth self-collision off");
   make->add_option("--rest-blend", mk->rest_blend_frames, "frames blending from the rest pose")
       ->capture_default_str()

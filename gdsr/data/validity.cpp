@@ -61,21 +61,49 @@ void measure_intersections(const std::vector<Points3>& frames, const Faces& F, i
   r.si_median_pairs = median(pairs);
 }
 
-// Deepest garment vertex under the body surface (metres, 0 if none).
-double penetration(const BodyQuery& body, const Points3& X) {
+struct Depths {
+  double all = 0, free = 0, pinched = 0;  // deepest vertex under the body surface, metres (0 if none)
+};
+
+// Deepest garment vertex under the body surface, overall and split by pinch (validity.hpp).
+// body_rest: the body in the first frame, where body parts are told apart.
+Depths penetration(const BodyQuery& body, const Points3& body_rest, const Points3& X, const ValidityOptions& opt) {
   const ClosestPoints cp = body.closest(X, /*smooth_normals=*/false);
-  double depth = 0;
-  for (long i = 0; i < X.rows(); ++i)
-    if (cp.face(i) >= 0 && cp.sdist(i) < 0) depth = std::max(depth, -cp.sdist(i));
-  return depth;
+  const Points3& B = body.mesh().V;
+  const Faces& F = body.mesh().F;
+  const double reach2 = opt.pinch_reach * opt.pinch_reach, sep2 = opt.pinch_separation * opt.pinch_separation;
+  Depths d;
+  for (long i = 0; i < X.rows(); ++i) {
+    if (cp.face(i) < 0 || !(cp.sdist(i) < 0)) continue;
+    const double depth = -cp.sdist(i);
+    d.all = std::max(d.all, depth);
+    const int f = cp.face(i);
+    const Vec3 rest = cp.bary(i, 0) * body_rest.row(F(f, 0)) + cp.bary(i, 1) * body_rest.row(F(f, 1)) +
+                      cp.bary(i, 2) * body_rest.row(F(f, 2));
+    bool pinched = false;
+    for (long j = 0; j < B.rows() && !pinched; ++j)
+      pinched = (B.row(j) - X.row(i)).squaredNorm() < reach2 &&
+                (body_rest.row(j) - rest.transpose()).squaredNorm() > sep2;
+    if (pinched)
+      d.pinched = std::max(d.pinched, depth);
+    else
+      d.free = std::max(d.free, depth);
+  }
+  return d;
 }
 
-void add_penetration(double depth, int t, double limit, ResolutionValidity& r) {
-  if (depth > r.max_penetration) {  // the frame stays -1 while nothing penetrates
-    r.max_penetration = depth;
+void add_penetration(const Depths& d, int t, double limit, ResolutionValidity& r) {
+  if (d.all > r.max_penetration) {  // the frame stays -1 while nothing penetrates
+    r.max_penetration = d.all;
     r.max_penetration_frame = t;
   }
-  r.frames_over_limit += depth > limit;
+  if (d.free > r.max_penetration_free) {
+    r.max_penetration_free = d.free;
+    r.max_penetration_free_frame = t;
+  }
+  r.frames_over_limit += d.all > limit;
+  r.frames_over_limit_free += d.free > limit;
+  r.pinch_frames += d.pinched > limit;
 }
 
 double mean_distance(const Points3& a, const Points3& b) {
@@ -91,6 +119,7 @@ double ValidityFigures::strain_ratio_uv() const { return ratio(hr.strain.E_uv, l
 ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, const ProgressFn& progress) {
   if (opt.intersection_stride < 1) fail("validity", "intersection stride must be >= 1");
   if (!(opt.penetration_limit >= 0)) fail("validity", "penetration limit must be >= 0");
+  if (!(opt.pinch_reach > 0) || !(opt.pinch_separation > 0)) fail("validity", "pinch reach and separation must be > 0");
   const int T = static_cast<int>(d.lr_frames.size());
   if (T == 0 || d.hr_frames.size() != d.lr_frames.size())
     fail("validity", "the dataset has no frames (or LR/HR counts differ)");
@@ -129,8 +158,9 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
         body = std::make_unique<BodyQuery>(mesh);
       else
         body->update(d.body_frames[t]);
-      add_penetration(penetration(*body, d.lr_frames[t]), t, opt.penetration_limit, v.lr);
-      add_penetration(penetration(*body, d.hr_frames[t]), t, opt.penetration_limit, v.hr);
+      const Points3& rest = d.body_frames[0];
+      add_penetration(penetration(*body, rest, d.lr_frames[t], opt), t, opt.penetration_limit, v.lr);
+      add_penetration(penetration(*body, rest, d.hr_frames[t], opt), t, opt.penetration_limit, v.hr);
     }
     if (progress) progress(t + 1, steps);
   }
@@ -161,7 +191,11 @@ nlohmann::json resolution_json(const ResolutionValidity& r, bool body) {
   if (body)
     j["body"] = {{"max_penetration_m", r.max_penetration},
                  {"max_penetration_frame", r.max_penetration_frame},
-                 {"frames_over_limit", r.frames_over_limit}};
+                 {"frames_over_limit", r.frames_over_limit},
+                 {"max_penetration_outside_pinches_m", r.max_penetration_free},
+                 {"max_penetration_outside_pinches_frame", r.max_penetration_free_frame},
+                 {"frames_over_limit_outside_pinches", r.frames_over_limit_free},
+                 {"pinch_frames", r.pinch_frames}};
   return j;
 }
 
@@ -196,6 +230,13 @@ ResolutionValidity resolution_from_json(const nlohmann::json& j, bool body, cons
     r.max_penetration = take<double>(b, "max_penetration_m", where + "body.");
     r.max_penetration_frame = take<int>(b, "max_penetration_frame", where + "body.");
     r.frames_over_limit = take<int>(b, "frames_over_limit", where + "body.");
+    // Manifests written before pinches were told apart count every penetration as free.
+    const bool split = b.contains("pinch_frames");
+    r.max_penetration_free = split ? take<double>(b, "max_penetration_outside_pinches_m", where + "body.") : r.max_penetration;
+    r.max_penetration_free_frame =
+        split ? take<int>(b, "max_penetration_outside_pinches_frame", where + "body.") : r.max_penetration_frame;
+    r.frames_over_limit_free = split ? take<int>(b, "frames_over_limit_outside_pinches", where + "body.") : r.frames_over_limit;
+    r.pinch_frames = split ? take<int>(b, "pinch_frames", where + "body.") : 0;
   }
   return r;
 }
@@ -275,10 +316,20 @@ std::string validity_table(const ValidityFigures& v) {
       std::snprintf(b, sizeof b, "%.1f (f%3d)", 1e3 * r.max_penetration, r.max_penetration_frame);
       return std::string(b);
     };
+    auto depth_free = [](const ResolutionValidity& r) {
+      char b[48];
+      if (r.max_penetration_free_frame < 0) return std::string("none");
+      std::snprintf(b, sizeof b, "%.1f (f%3d)", 1e3 * r.max_penetration_free, r.max_penetration_free_frame);
+      return std::string(b);
+    };
+    const std::string mm = std::to_string(static_cast<int>(std::lround(1e3 * v.penetration_limit))) + " mm";
     line("  %-40s %14s %14s\n", "body: max penetration, mm (frame)", depth(v.lr).c_str(), depth(v.hr).c_str());
-    line("  body: frames deeper than %-15s %14d %14d\n",
-         (std::to_string(static_cast<int>(std::lround(1e3 * v.penetration_limit))) + " mm").c_str(),
-         v.lr.frames_over_limit, v.hr.frames_over_limit);
+    line("  body: frames deeper than %-15s %14d %14d\n", mm.c_str(), v.lr.frames_over_limit, v.hr.frames_over_limit);
+    line("  %-40s %14s %14s\n", "body: outside pinches: max, mm (frame)", depth_free(v.lr).c_str(),
+         depth_free(v.hr).c_str());
+    line("  body: outside pinches: frames > %-7s %14d %14d\n", mm.c_str(), v.lr.frames_over_limit_free,
+         v.hr.frames_over_limit_free);
+    line("  body: pinch frames (2nd part, > %-7s %14d %14d\n", (mm + ")").c_str(), v.lr.pinch_frames, v.hr.pinch_frames);
   } else {
     line("  %-40s %14s %14s\n", "body: penetration", "not measured", "(no body)");
   }

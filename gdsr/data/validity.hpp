@@ -6,7 +6,10 @@
 //     count), on every `intersection_stride`-th frame;
 //   - strain: mean E_u, E_v, E_uv against the sewing pattern (gdsr/geometry/strain.hpp);
 //   - body: penetration depth = -signed distance to the body frame (Embree, exact closest
-//     point, gdsr/body/body_query.hpp), only when the dataset has a body;
+//     point, gdsr/body/body_query.hpp), only when the dataset has a body; a penetrating
+//     vertex is "pinched" when a second body part is within pinch_reach of it (a body vertex
+//     farther than pinch_separation, in the first frame, from the closest point): cloth
+//     between a hand and a hip cannot be outside both, so pinched frames are counted apart;
 //   - agreement: distance of each HR vertex to the LR frame upsampled to HR topology through
 //     the dataset's correspondence (gdsr/geometry/correspondence.hpp);
 //   - wrinkles: mean absolute mean curvature of HR, LR upsampled and LR
@@ -29,6 +32,8 @@ struct ValidityOptions {
   int intersection_stride = 1;       // self-intersections on frames 0, k, 2k, ... (>= 1)
   double penetration_limit = 0.005;  // metres: frames with a deeper vertex are counted
   bool body = true;                  // false: skip the penetration even if the dataset has a body
+  double pinch_reach = 0.04;         // metres: a second body part this close to a penetrating vertex pinches it
+  double pinch_separation = 0.15;    // metres apart in the first frame: two points on different body parts
 };
 
 // Figures of one resolution (LR or HR) over the clip.
@@ -49,6 +54,11 @@ struct ResolutionValidity {
   double max_penetration = 0;      // metres, max over frames and vertices of -signed distance (0: none)
   int max_penetration_frame = -1;  // -1: no vertex penetrates in any frame
   int frames_over_limit = 0;       // frames whose max penetration exceeds the limit
+  // the same over vertices that are not pinched (see the header comment)
+  double max_penetration_free = 0;
+  int max_penetration_free_frame = -1;
+  int frames_over_limit_free = 0;
+  int pinch_frames = 0;  // frames where a pinched vertex is deeper than the limit
   double mean_curvature = 0;       // 1/m, mean over frames
 };
 

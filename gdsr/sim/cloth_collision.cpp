@@ -40,7 +40,8 @@ void SurfaceGrid::build(const gdsr::Faces& F, const gdsr::Points3& V0, const gds
   }
 }
 
-SurfaceHit SurfaceGrid::closest(const Vec3& x, const gdsr::Points3& V, double radius) const {
+SurfaceHit SurfaceGrid::closest(const Vec3& x, const gdsr::Points3& V, double radius,
+                                const std::function<bool(int)>& accept) const {
   SurfaceHit hit;
   if (cells_.empty()) return hit;
   const auto& F = *F_;
@@ -58,6 +59,7 @@ SurfaceHit SurfaceGrid::closest(const Vec3& x, const gdsr::Points3& V, double ra
   cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
   Vec3 nsum = Vec3::Zero();
   for (int f : cand) {
+    if (accept && !accept(f)) continue;
     const Vec3 p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
     const Vec3 bc = gdsr::closest_point_on_triangle(x, p0, p1, p2).bary;
     const Vec3 q = bc.x() * p0 + bc.y() * p1 + bc.z() * p2;

@@ -7,6 +7,7 @@
 
 #include "gdsr/geometry/mesh.hpp"
 
+#include <functional>
 #include <unordered_map>
 #include <vector>
 
@@ -25,8 +26,10 @@ class SurfaceGrid {
   // Grid for triangles F over poses V0 and V1 (and any blend between them); cell in metres.
   void build(const gdsr::Faces& F, const gdsr::Points3& V0, const gdsr::Points3& V1, double cell);
   // Closest point on the surface with vertex positions V (same topology, a pose covered by
-  // build) to x, searching within `radius` metres.
-  SurfaceHit closest(const gdsr::Vec3& x, const gdsr::Points3& V, double radius) const;
+  // build) to x, searching within `radius` metres; only faces for which `accept(face)` holds
+  // when it is given.
+  SurfaceHit closest(const gdsr::Vec3& x, const gdsr::Points3& V, double radius,
+                     const std::function<bool(int)>& accept = {}) const;
   bool empty() const { return cells_.empty(); }
 
  private:

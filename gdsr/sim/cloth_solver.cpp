@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -53,6 +54,8 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     gdsr::fail("sim/cloth_solver", "substeps, iterations, stretch_passes and contact_every must be >= 1");
   if (!(p.density > 0) || !(p.stretch_stiffness > 0) || !(p.bend_stiffness > 0))
     gdsr::fail("sim/cloth_solver", "density and stiffnesses must be positive");
+  if (!(p.compression_ratio > 0 && p.compression_ratio <= 1))
+    gdsr::fail("sim/cloth_solver", "compression_ratio must be in (0, 1]");
   if (body_F.rows() > 0 && body_F.maxCoeff() >= body_V0.rows())
     gdsr::fail("sim/cloth_solver", "body faces index missing vertices");
   if (!m.V.allFinite()) gdsr::fail("sim/cloth_solver", "garment rest positions are not finite");
@@ -125,6 +128,16 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
       if (hit.face >= 0 && hit.signed_distance < p.thickness)
         x_.row(v) = (hit.point + hit.normal * p.thickness).transpose();
     }
+    // Where each vertex was dressed: its closest body point in the first pose (within 0.3 m).
+    if (!(p.pinch_separation > 0)) gdsr::fail("sim/cloth_solver", "pinch_separation must be positive");
+    body_rest_ = body_V0;
+    home_ = Points3::Constant(nv, 3, std::numeric_limits<double>::quiet_NaN());
+    SurfaceGrid wide;
+    wide.build(bodyF_, body_V0, body_V0, 0.15);
+    for (int v = 0; v < nv; ++v) {
+      const SurfaceHit hit = wide.closest(x_.row(v).transpose(), body_V0, 0.3);
+      if (hit.face >= 0) home_.row(v) = hit.point.transpose();
+    }
   }
   if (!g.pinned.empty() && body_F.rows() == 0) {  // no body: pinned vertices are fixed in space
     for (int v : g.pinned) {
@@ -191,12 +204,35 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
   const int nv = static_cast<int>(x_.rows());
   if (bodyF_.rows() > 0) {
     const double r = p_.thickness + p_.contact_radius;
+    const double sep2 = p_.pinch_separation * p_.pinch_separation;
+    auto add = [&](int v, const SurfaceHit& hit) {
+      // Deeper than max_push: the vertex went through a thin part; pushing it out would tear
+      // the cloth, so leave it.
+      if (hit.signed_distance > -p_.max_push) contacts_.push_back({v, hit.face, hit.bary});
+    };
     for (int v = 0; v < nv; ++v) {
       if (winv_[v] == 0) continue;
-      const SurfaceHit hit = grid_.closest(x_.row(v).transpose(), body_now, r);
-      // Deeper than max_push: the vertex went through a thin part or is pinched (e.g. between
-      // an arm and the pinned waistband); pushing it out would tear the cloth, so leave it.
-      if (hit.face >= 0 && hit.signed_distance > -p_.max_push) contacts_.push_back({v, hit.face, hit.bary});
+      const Vec3 x = x_.row(v).transpose();
+      const SurfaceHit a = grid_.closest(x, body_now, r);
+      if (a.face < 0) continue;
+      // A second body part within reach (far from the first one in the first pose): the cloth
+      // may be pinched between them (a hand pressing a skirt onto the hip). Both contacts
+      // apply; the part the vertex was dressed on comes last, so it wins when they conflict.
+      const Vec3 ra = bary_point(body_rest_, bodyF_, a.face, a.bary);
+      const SurfaceHit b = grid_.closest(x, body_now, r, [&](int f) {
+        for (int k = 0; k < 3; ++k)
+          if ((body_rest_.row(bodyF_(f, k)).transpose() - ra).squaredNorm() <= sep2) return false;
+        return true;
+      });
+      if (b.face < 0 || !home_.row(v).allFinite()) {
+        add(v, a);
+        continue;
+      }
+      const Vec3 home = home_.row(v).transpose();
+      const Vec3 rb = bary_point(body_rest_, bodyF_, b.face, b.bary);
+      const bool a_home = (ra - home).squaredNorm() <= (rb - home).squaredNorm();
+      add(v, a_home ? b : a);
+      add(v, a_home ? a : b);
     }
   }
   layer_pairs_.clear();
@@ -269,6 +305,20 @@ void ClothSolver::predict(double h, double decay) {
   }
 }
 
+void ClothSolver::classify_edges() {
+  // Once per substep, before the passes, each edge's compliance factor from its strain: 1 when
+  // stretched, 1 / compression_ratio beyond 0.1% compression, a smoothstep between (a jump at
+  // zero strain, or a switch between passes with lambda from the other regime, makes edges
+  // near their rest length chatter).
+  const double eps0 = 1e-3;
+  edge_scale_.resize(edges_.size());
+  for (size_t c = 0; c < edges_.size(); ++c) {
+    const double strain = (x_.row(edges_[c].i) - x_.row(edges_[c].j)).norm() / edges_[c].rest - 1;
+    const double t = std::clamp(1 + strain / eps0, 0.0, 1.0), s = t * t * (3 - 2 * t);
+    edge_scale_[c] = 1 / (p_.compression_ratio + (1 - p_.compression_ratio) * s);
+  }
+}
+
 void ClothSolver::solve_edges(std::vector<double>& lambda_e, double h2) {
   for (size_t c = 0; c < edges_.size(); ++c) {
     const Edge& e = edges_[c];
@@ -278,7 +328,7 @@ void ClothSolver::solve_edges(std::vector<double>& lambda_e, double h2) {
     const double len = d.norm();
     if (len < 1e-12) continue;
     d /= len;
-    const double at = e.compliance / h2;
+    const double at = edge_scale_[c] * e.compliance / h2;
     const double dl = (-(len - e.rest) - at * lambda_e[c]) / (wi + wj + at);
     lambda_e[c] += dl;
     x_.row(e.i) += (wi * dl) * d.transpose();
@@ -388,6 +438,7 @@ void ClothSolver::step(const Points3& body_from, const Points3& body_to, double 
     if (has_body) place_pins(body_now);
     if (implicit_bending_) implicit_bending_->solve(h, x_);
     std::fill(lambda_e.begin(), lambda_e.end(), 0.0);
+    classify_edges();
     std::fill(lambda_b.begin(), lambda_b.end(), 0.0);
     for (int it = 0; it < p_.iterations; ++it) {
       for (int k = 0; k < p_.stretch_passes; ++k) {
@@ -417,11 +468,16 @@ std::vector<Points3> simulate_frames(const Garment& g, const gdsr::Faces& body_F
   const double dt = 1.0 / fps;
   const int total = static_cast<int>(frames.size()) + p.settle_frames;
   int done = 0;
+  // Damped dynamics on the first pose: zeroing the velocity after every frame instead would let
+  // the garment fall only ~0.5 g dt^2 (5 mm at 30 fps) per frame, so the clip would start in
+  // the placement shape and the fall would happen during the motion, differently at each resolution.
+  solver.set_damping(p.settle_damping);
   for (int k = 0; k < p.settle_frames; ++k) {
     solver.step(frames[0], frames[0], dt);
-    solver.zero_velocities();  // relax the rest placement quasi-statically
     if (progress) progress(++done, total);
   }
+  solver.set_damping(p.damping);
+  solver.zero_velocities();
   std::vector<Points3> out;
   out.reserve(frames.size());
   out.push_back(solver.positions());

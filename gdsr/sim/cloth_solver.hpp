@@ -34,6 +34,10 @@ struct SimParams {
   double friction = 0.3;            // Coulomb coefficient against the body
   double density = 0.08;            // kg/m^2 (silk charmeuse ~0.06-0.09)
   double stretch_stiffness = 2000;  // N/m (2-D Young's modulus per edge-area share)
+  double compression_ratio = 0.01;  // stiffness of a shortened edge / stretch_stiffness: woven fabric buckles
+                                    // at scales below the particle distance rather than resisting in-plane
+                                    // compression (Marvelous Designer's "buckling ratio"); at 1 a 30 mm mesh
+                                    // flares out stiffly where a 10 mm one hangs in folds (membrane locking)
   double bend_stiffness = 2e-6;     // N m (isometric bending modulus; silk is very soft)
   double damping = 0.5;             // 1/s, velocity decay (air drag)
   gdsr::Vec3 gravity = gdsr::Vec3(0, -9.81, 0);  // m/s^2
@@ -41,8 +45,12 @@ struct SimParams {
   double contact_radius = 0.03;                  // m, body search radius beyond thickness
   int contact_every = 5;                         // substeps between contact refreshes
   double max_push = 0.02;                        // m, vertices deeper than this inside the body are not pushed out
+  double pinch_separation = 0.15;  // m: body points this far apart in the first pose are different parts (a hand
+                                   // and a hip); cloth pinched between two parts stays on the part it was dressed on
   double max_speed = 15;                         // m/s, velocity clamp (safety against fast body parts)
-  int settle_frames = 15;      // frames simulated on the first body pose before frame 0 (velocities zeroed after each)
+  int settle_frames = 30;      // frames simulated on the first body pose before frame 0 (velocities zeroed at the end)
+  double settle_damping = 6;   // 1/s, velocity decay while settling: the placed garment falls and swings out within
+                               // ~1 s instead of starting the clip in its placement shape
   bool self_collision = true;  // cloth-cloth contact (vertex-triangle and edge-edge)
   double self_thickness = 0.003;  // m, non-adjacent cloth kept this far apart
   int self_detect_every = 4;      // substeps between self-contact detections (sooner when a vertex leaves its slack)
@@ -61,8 +69,10 @@ class ClothSolver {
   ClothSolver(const Garment& g, const gdsr::Faces& body_F, const gdsr::Points3& body_V0, const SimParams& p);
   // Advances one frame of length dt seconds while the body moves from body_from to body_to.
   void step(const gdsr::Points3& body_from, const gdsr::Points3& body_to, double dt);
-  // Sets every velocity to zero (quasi-static relaxation between settle frames).
+  // Sets every velocity to zero (the end of the settle).
   void zero_velocities() { v_.setZero(); }
+  // Velocity decay in 1/s from the next step on (the settle damps harder than the clip).
+  void set_damping(double per_second) { p_.damping = per_second; }
   const gdsr::Points3& positions() const { return x_; }
   const gdsr::Points3& velocities() const { return v_; }       // m/s
   const std::vector<double>& masses() const { return mass_; }  // kg per vertex (pinned too)
@@ -102,6 +112,7 @@ class ClothSolver {
   // The steps of one substep of length h (seconds), in the order step() runs them.
   void detect_self_contacts(double h);
   void predict(double h, double decay);
+  void classify_edges();
   void solve_edges(std::vector<double>& lambda, double h2);
   void solve_bends(std::vector<double>& lambda, double h2);
   void solve_layers();
@@ -117,11 +128,14 @@ class ClothSolver {
   gdsr::Points3 x_, v_, xprev_;
   std::vector<double> mass_, winv_;
   std::vector<Edge> edges_;
+  std::vector<double> edge_scale_;  // per edge, this substep: compliance factor (1 stretched, 1/compression_ratio)
   std::vector<Bend> bends_;
   std::vector<Pin> pins_;
   std::vector<Tether> tethers_;
   std::unique_ptr<ImplicitBending> implicit_bending_;
   std::vector<Contact> contacts_;
+  gdsr::Points3 body_rest_;                // body vertices in the first pose (pinch_separation is measured there)
+  gdsr::Points3 home_;                     // per cloth vertex: closest body point in the first pose (NaN: none)
   std::vector<LayerPair> layer_pairs_;
   SurfaceGrid grid_;
   double body_cell_ = 0.05;

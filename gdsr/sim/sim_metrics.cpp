@@ -2,9 +2,8 @@
 
 #include "gdsr/error.hpp"
 
+#include "gdsr/body/body_query.hpp"
 #include "gdsr/geometry/triangle.hpp"
-
-#include "gdsr/sim/cloth_collision.hpp"
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
@@ -20,16 +19,17 @@ using gdsr::Vec2;
 using gdsr::Vec3;
 
 Penetration body_penetration(const Points3& X, const gdsr::Faces& body_F, const Points3& body_V, double radius) {
+  // Embree closest points with the pseudonormal sign (gdsr/body/body_query.hpp): independent of
+  // the solver's own contact grid (sim/cloth_collision.hpp), so the figure can catch its mistakes.
   Penetration p;
   if (body_F.rows() == 0 || X.rows() == 0) return p;
-  SurfaceGrid grid;
-  grid.build(body_F, body_V, body_V, std::max(radius, 0.02));
+  const gdsr::BodyQuery query(gdsr::TriMesh{body_V, body_F});
+  const gdsr::ClosestPoints c = query.closest(X, /*smooth_normals=*/false, radius);
   double sum = 0;
   for (int v = 0; v < X.rows(); ++v) {
-    const SurfaceHit h = grid.closest(X.row(v).transpose(), body_V, radius);
-    if (h.face >= 0 && h.signed_distance < 0) {
-      p.max_depth = std::max(p.max_depth, -h.signed_distance);
-      sum += -h.signed_distance;
+    if (c.face(v) >= 0 && c.sdist(v) < 0) {
+      p.max_depth = std::max(p.max_depth, -c.sdist(v));
+      sum += -c.sdist(v);
       ++p.count;
     }
   }

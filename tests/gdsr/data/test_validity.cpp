@@ -101,6 +101,49 @@ TEST_CASE("gdsr: validity figures of a stretched, lifted sheet over a rising box
   CHECK(gdsr::validity_table(v).find("max penetration") != std::string::npos);
 }
 
+TEST_CASE("gdsr: validity counts penetration under a second body part as a pinch") {
+  // The rising box of the test above plus a "hand" box that is 0.5 m away in frame 0 and, in
+  // frame 2 only, hovers 1 cm above the sheet where the body pokes through it (8 mm LR, 6 mm
+  // HR): cloth between two parts cannot be outside both, so frame 2 is a pinch frame and the
+  // figures outside pinches come from frames 1 and 3.
+  const std::vector<double> top = {0.001, 0.004, 0.008, 0.003};
+  gdsr::Dataset d = stretched_dataset(top);
+  const gdsr::TriMesh far = box(0.6, 0.65, 0.13, 0.17, 0.01, 0.05), near = box(0.14, 0.19, 0.13, 0.17, 0.01, 0.05);
+  gdsr::Faces F(d.body_faces.rows() * 2, 3);
+  F << d.body_faces, (far.F.array() + 8).matrix();
+  d.body_faces = F;
+  for (size_t t = 0; t < d.body_frames.size(); ++t) {
+    Points3 V(16, 3);
+    V << d.body_frames[t], (t == 2 ? near : far).V;
+    d.body_frames[t] = V;
+  }
+  gdsr::ValidityOptions opt;
+  opt.penetration_limit = 0.0035;
+  const gdsr::ValidityFigures v = gdsr::measure_validity(d, opt);
+  CHECK(v.lr.max_penetration == doctest::Approx(0.008).epsilon(1e-9));  // every vertex still counts here
+  CHECK(v.lr.frames_over_limit == 2);
+  CHECK(v.lr.max_penetration_free == doctest::Approx(0.004).epsilon(1e-9));
+  CHECK(v.lr.max_penetration_free_frame == 1);
+  CHECK(v.lr.frames_over_limit_free == 1);
+  CHECK(v.lr.pinch_frames == 1);
+  CHECK(v.hr.max_penetration_free == doctest::Approx(0.002).epsilon(1e-9));
+  CHECK(v.hr.max_penetration_free_frame == 1);
+  CHECK(v.hr.frames_over_limit_free == 0);
+  CHECK(v.hr.pinch_frames == 1);
+  // A reach shorter than the 1 cm gap: no pinch, everything counts.
+  opt.pinch_reach = 0.005;
+  const gdsr::ValidityFigures narrow = gdsr::measure_validity(d, opt);
+  CHECK(narrow.lr.max_penetration_free == doctest::Approx(0.008).epsilon(1e-9));
+  CHECK(narrow.lr.pinch_frames == 0);
+  // The split survives the manifest, and the table prints it.
+  const gdsr::ValidityFigures back = gdsr::validity_from_json(gdsr::validity_to_json(v));
+  CHECK(back.hr.max_penetration_free == v.hr.max_penetration_free);
+  CHECK(back.lr.pinch_frames == 1);
+  CHECK(gdsr::validity_table(v).find("pinch frames") != std::string::npos);
+  opt.pinch_reach = 0;
+  CHECK_THROWS_AS(gdsr::measure_validity(d, opt), gdsr::Error);
+}
+
 TEST_CASE("gdsr: validity counts the HR frames that overlap themselves, on every k-th frame") {
   gdsr::Dataset d = gdsr_test::wave_dataset(4);
   // Frame 2: the HR sheet wrapped 1.25 times round a cylinder, so a quarter lies on itself.
