@@ -67,6 +67,7 @@ template <class T> ag::Tensor<T> local_to_world(const ag::Tensor<T>& r, const ag
 }
 
 template <class T> ag::Tensor<T> vertex_normals_ad(const ag::Tensor<T>& X, const Faces& F, T eps) {
+  if (!(eps > T(0))) gdsr::fail("vertex_normals_ad", "eps must be > 0 (a fraction of the vertex's area)");
   ag::Index all(F.rows());
   for (int64_t f = 0; f < F.rows(); ++f) all[f] = f;
   const ag::Tensor<T> v0 = ag::index_select_rows(X, face_column(F, all, 0));
@@ -78,7 +79,11 @@ template <class T> ag::Tensor<T> vertex_normals_ad(const ag::Tensor<T>& X, const
   for (int64_t f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) corner_face[3 * f + k] = f, corner_vertex[3 * f + k] = F(f, k);
   const ag::Tensor<T> sum = ag::scatter_add_rows(ag::index_select_rows(c, corner_face), corner_vertex, X.rows());
-  return ag::normalize_rows(sum, eps);
+  // The floor scales with the vertex's own area (an absolute eps would shrink the normals of
+  // a mesh in small units).
+  const ag::Tensor<T> area = ag::scatter_add_rows(ag::index_select_rows(ag::norm_rows(c), corner_face), corner_vertex,
+                                                  X.rows());
+  return normalize_rows_floor(sum, ag::mul_scalar(area, eps));
 }
 
 #define INSTANTIATE(T)                                                                                   \

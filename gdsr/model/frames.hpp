@@ -24,8 +24,11 @@ ag::Tensor<T> triangle_frames_ad(const ag::Tensor<T>& X, const Faces& F, const a
 // r0 x + r1 y + r2 z -> [N x 3].
 template <class T> ag::Tensor<T> local_to_world(const ag::Tensor<T>& r, const ag::Tensor<T>& frames);
 
-// Area-weighted unit vertex normals [V x 3]: sum over adjacent faces of
-// (v1 - v0) x (v2 - v0), divided by max(|sum|, eps) (eps in metres^2).
-template <class T> ag::Tensor<T> vertex_normals_ad(const ag::Tensor<T>& X, const Faces& F, T eps = T(1e-12));
+// Area-weighted unit vertex normals [V x 3]: sum over adjacent faces of c = (v1 - v0) x
+// (v2 - v0), divided by max(|sum|, eps * sum |c|). eps > 0 is dimensionless (relative to the
+// vertex's own doubled area, so normals do not change when X is scaled): unit normals except
+// where the adjacent faces fold onto each other to within eps; 0 at an isolated vertex or one
+// whose faces all have zero area.
+template <class T> ag::Tensor<T> vertex_normals_ad(const ag::Tensor<T>& X, const Faces& F, T eps = T(1e-6));
 
 }  // namespace gdsr

@@ -162,3 +162,34 @@ TEST_CASE("frames: eps must be positive") {
   CHECK_THROWS_WITH_AS(triangle_frames_ad(to_tensor<double>(V), consecutive_faces(1), all_faces(1), 0.0),
                        doctest::Contains("eps"), std::runtime_error);
 }
+
+TEST_CASE("frames: vertex normals are unit and identical from 1e-5 to 1e3 scale") {
+  // The model's vertex-normal features: eps is relative to each vertex's own area, so a
+  // garment in other units gets the same normals. The former absolute eps of 1e-12 m^2 shrank
+  // them wherever the summed doubled area of a vertex's faces fell below it: at x1e-5 here
+  // (0.2 um edges, ~2.4e-13 m^2 around an interior vertex) to about 0.24.
+  const GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec::spaced(5, 0.02));
+  const Points3 base = gdsr_test::bumpy(g.V, 0.2, 1.0, 3);
+  const Points3 ref = to_points(vertex_normals_ad(to_tensor<double>(base), g.F));
+  for (int i = 0; i < ref.rows(); ++i) CHECK(ref.row(i).norm() == doctest::Approx(1.0).epsilon(1e-14));
+  for (double s : {1e-5, 1e-3, 1e3}) {
+    CAPTURE(s);
+    const Points3 n = to_points(vertex_normals_ad(to_tensor<double>(Points3(base * s)), g.F));
+    CHECK((n - ref).cwiseAbs().maxCoeff() < 1e-14);
+    const ag::GradCheckResult r = ag::gradcheck(
+        [&](const std::vector<ag::Tensord>& x) { return vertex_normals_ad(x[0], g.F); },
+        {to_tensor<double>(Points3(base * s))});
+    INFO(r.report());
+    CHECK(r.max_rel_error < 1e-6);
+  }
+  // A vertex whose faces all have zero area gets the zero normal, finite gradients.
+  Points3 flat = base;
+  flat.row(g.F(0, 1)) = flat.row(g.F(0, 0));
+  flat.row(g.F(0, 2)) = flat.row(g.F(0, 0));
+  ag::Tensord X = to_tensor<double>(flat);
+  X.set_requires_grad(true);
+  ag::sum(vertex_normals_ad(X, g.F)).backward();
+  for (double v : X.grad()) CHECK(std::isfinite(v));
+  CHECK_THROWS_WITH_AS(vertex_normals_ad(to_tensor<double>(base), g.F, 0.0), doctest::Contains("eps"),
+                       std::runtime_error);
+}
