@@ -46,6 +46,17 @@ ag::Tensord rows_of(const Points3& P, const std::vector<int>& rows) {
   return to_tensor<double>(R);
 }
 
+// A 5 x 5 grid (5 cm) with a ground truth and a prediction, and the corners a, b, c of its
+// interior face f0 (made degenerate by the tests).
+struct GridPrediction {
+  GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec::spaced(5, 0.05));
+  MeshTopology t = make_topology(g);
+  Points3 gt = gdsr_test::bumpy(g.V, 0.2, 1.0, 1);
+  Points3 base = gdsr_test::bumpy(g.V, 0.2, 1.0, 2);
+  int f0 = 12;
+  int a = g.F(f0, 0), b = g.F(f0, 1), c = g.F(f0, 2);
+};
+
 }  // namespace
 
 TEST_CASE("losses: config defaults follow the reference, JSON round trip, unknown keys throw") {
@@ -232,19 +243,13 @@ TEST_CASE("losses: a predicted sliver's dihedral gradient stays bounded as its h
   // The dihedral angle's gradient is 1 / height on a sliver; the fade weight (min(1, |cross| /
   // dihedral_floor) per face) caps it at ~ (1 + pi) edge / dihedral_floor, independent of the
   // height. Unweighted, 1e-12 m would give 1000x 1e-9 m's.
-  const GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec::spaced(5, 0.05));
-  const MeshTopology t = make_topology(g);
-  const Points3 gt = gdsr_test::bumpy(g.V, 0.2, 1.0, 1);
-  const Points3 base = gdsr_test::bumpy(g.V, 0.2, 1.0, 2);
-  const int f0 = 12;
-  const int a = g.F(f0, 0), b = g.F(f0, 1), c = g.F(f0, 2);
+  const GridPrediction m;
+  const MeshTopology& t = m.t;
+  const Points3 &gt = m.gt, &base = m.base;
+  const int f0 = m.f0, a = m.a, b = m.b, c = m.c;
   const LossConfig cfg = only("c_dihedral");
   auto sliver_gradient = [&](double h, double* healthy) {
-    Points3 pred = base;
-    const Eigen::RowVector3d e = (pred.row(c) - pred.row(b)).normalized();
-    const Eigen::RowVector3d up = e.cross(Eigen::RowVector3d(0, 0, 1)).normalized().cross(e);
-    pred.row(a) = 0.5 * (pred.row(b) + pred.row(c)) + h * up;
-    ag::Tensord x = to_tensor<double>(pred);
+    ag::Tensord x = to_tensor<double>(gdsr_test::sliver(base, a, b, c, h));
     x.set_requires_grad(true);
     coarse_loss(cfg, t, x, gt).total.backward();
     REQUIRE(finite(x.grad()));
@@ -278,51 +283,33 @@ TEST_CASE("losses: the dihedral weighting leaves healthy meshes unchanged") {
       ag::l1_loss(dihedral_angles(to_tensor<double>(pred), t), dihedral_angles(to_tensor<double>(gt), t));
   CHECK(l.dihedral == doctest::Approx(plain.item()).epsilon(1e-14));
 }
+
 TEST_CASE("losses: one degenerate triangle cannot dominate a training step") {
   // The whole coarse loss (reference weights) of a 5 x 5 grid prediction (5 cm spacing) with
   // one interior triangle made degenerate. Per-vertex gradient norms |dL/dx_v| at the
   // degenerate triangle's corners must stay within 100 x the median over the vertices of the
   // healthy prediction. Before: a 1e-9 m sliver or a zero-area face gave ~7e4 x (dihedral
   // term, angle gradient 1 / height), coincident vertices or a face collapsed to a point ~1e5 x
-  // (shear of the strain term, 1 / max(|F_v|, 1e-6)). Now: ~7 x and ~12 x.
-  const GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec::spaced(5, 0.05));
-  const MeshTopology t = make_topology(g);
-  const Points3 gt = gdsr_test::bumpy(g.V, 0.2, 1.0, 1);
-  const Points3 base = gdsr_test::bumpy(g.V, 0.2, 1.0, 2);
-  const int f0 = 12;
-  const int a = g.F(f0, 0), b = g.F(f0, 1), c = g.F(f0, 2);
+  // (shear of the strain term, 1 / max(|F_v|, 1e-6)). Now: 8-9 x and 11-12 x.
+  const GridPrediction m;
+  const MeshTopology& t = m.t;
+  const Points3 &gt = m.gt, &base = m.base;
+  const int a = m.a, b = m.b, c = m.c;
   auto vertex_gradients = [&](const Points3& pred, const LossConfig& cfg) {
     ag::Tensord x = to_tensor<double>(pred);
     x.set_requires_grad(true);
     coarse_loss(cfg, t, x, gt).total.backward();
     REQUIRE(finite(x.grad()));
-    std::vector<double> n(static_cast<size_t>(t.num_vertices));
-    for (int i = 0; i < t.num_vertices; ++i)
-      n[i] = Eigen::Vector3d(x.grad()[3 * i], x.grad()[3 * i + 1], x.grad()[3 * i + 2]).norm();
-    return n;
+    return gdsr_test::vertex_norms(x.grad());
   };
-  std::vector<double> healthy = vertex_gradients(base, LossConfig{});
-  std::nth_element(healthy.begin(), healthy.begin() + healthy.size() / 2, healthy.end());
-  const double median = healthy[healthy.size() / 2];
+  const double median = gdsr_test::median(vertex_gradients(base, LossConfig{}));
   REQUIRE(median > 0);
-  const Eigen::RowVector3d e = (base.row(c) - base.row(b)).normalized();
-  const Eigen::RowVector3d up = e.cross(Eigen::RowVector3d(0, 0, 1)).normalized().cross(e);
-  const std::vector<std::pair<std::string, Points3>> cases = [&] {
-    std::vector<std::pair<std::string, Points3>> out;
-    for (const auto& [h, label] : {std::pair<double, const char*>{1e-5, "1e-5"}, {1e-9, "1e-9"}, {0.0, "0"}}) {
-      Points3 p = base;
-      p.row(a) = 0.5 * (p.row(b) + p.row(c)) + h * up;
-      out.push_back({std::string("sliver of height ") + label + " m", p});
-    }
-    Points3 p = base;
-    p.row(c) = p.row(b);
-    out.push_back({"coincident vertices", p});
-    p.row(a) = p.row(b);
-    out.push_back({"collapsed to a point", p});
-    return out;
-  }();
-  for (const auto& [name, pred] : cases) {
-    CAPTURE(name);
+  std::vector<gdsr_test::DegenerateCase> cases = gdsr_test::degenerate_cases(base, a, b, c);
+  cases.push_back({"sliver of 1e-5 m", gdsr_test::sliver(base, a, b, c, 1e-5)});
+  for (const gdsr_test::DegenerateCase& dc : cases) {
+    const std::string& name = dc.name;
+    const Points3& pred = dc.P;
+    INFO(name);
     const std::vector<double> n = vertex_gradients(pred, LossConfig{});
     const double worst = std::max({n[a], n[b], n[c]});
     std::string terms;  // per-term contribution, to find the culprit when this fails
@@ -402,23 +389,14 @@ TEST_CASE("losses: one degenerate triangle in a fine patch cannot dominate a tra
     x.set_requires_grad(true);
     fine_loss(cfg, batch, x, gt).total.backward();
     REQUIRE(finite(x.grad()));
-    std::vector<double> n(batch.vertices.size());
-    for (size_t i = 0; i < n.size(); ++i)
-      n[i] = Eigen::Vector3d(x.grad()[3 * i], x.grad()[3 * i + 1], x.grad()[3 * i + 2]).norm();
-    return n;
+    return gdsr_test::vertex_norms(x.grad());
   };
-  std::vector<double> healthy = vertex_gradients(base, LossConfig{});
-  std::nth_element(healthy.begin(), healthy.begin() + healthy.size() / 2, healthy.end());
-  const double median = healthy[healthy.size() / 2];
+  const double median = gdsr_test::median(vertex_gradients(base, LossConfig{}));
   REQUIRE(median > 0);
-  const Eigen::RowVector3d e = (base.row(c) - base.row(b)).normalized();
-  const Eigen::RowVector3d up = e.cross(Eigen::RowVector3d(0, 0, 1)).normalized().cross(e);
-  for (int kind = 0; kind < 4; ++kind) {
-    CAPTURE(kind);  // sliver 1e-9 m, zero area, coincident vertices, collapsed to a point
-    Points3 pred = base;
-    if (kind < 2) pred.row(a) = 0.5 * (pred.row(b) + pred.row(c)) + (kind == 0 ? 1e-9 : 0.0) * up;
-    if (kind >= 2) pred.row(c) = pred.row(b);
-    if (kind == 3) pred.row(a) = pred.row(b);
+  for (const gdsr_test::DegenerateCase& dc : gdsr_test::degenerate_cases(base, a, b, c)) {
+    const std::string& name = dc.name;
+    const Points3& pred = dc.P;
+    INFO(name);
     const std::vector<double> n = vertex_gradients(pred, LossConfig{});
     const double worst = std::max({n[row_of(a)], n[row_of(b)], n[row_of(c)]});
     std::string terms;
@@ -427,7 +405,7 @@ TEST_CASE("losses: one degenerate triangle in a fine patch cannot dominate a tra
       terms += std::string(" ") + term + " " +
                std::to_string(std::max({m[row_of(a)], m[row_of(b)], m[row_of(c)]}) / median);
     }
-    MESSAGE("case " << kind << ": " << worst / median << " x the healthy median;" << terms);
+    MESSAGE(name << ": " << worst / median << " x the healthy median;" << terms);
     CHECK(worst < 100 * median);
   }
 }

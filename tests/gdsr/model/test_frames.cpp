@@ -237,25 +237,16 @@ TEST_CASE("frames: a degenerate triangle of the predicted mesh cannot dominate t
     ag::Tensord x = to_tensor<double>(P);
     x.set_requires_grad(true);
     ag::l1_loss(G_of(x), G_star).backward();
-    std::vector<double> n(static_cast<size_t>(P.rows()));
-    for (int i = 0; i < P.rows(); ++i) n[i] = Eigen::Vector3d(x.grad()[3 * i], x.grad()[3 * i + 1], x.grad()[3 * i + 2]).norm();
-    return n;
+    return gdsr_test::vertex_norms(x.grad());
   };
-  std::vector<double> healthy = vertex_norms(base);
-  std::nth_element(healthy.begin(), healthy.begin() + healthy.size() / 2, healthy.end());
-  const double median = healthy[healthy.size() / 2];
+  const double median = gdsr_test::median(vertex_norms(base));
   REQUIRE(median > 0);
-  const Eigen::RowVector3d e = (base.row(c) - base.row(b)).normalized();
-  const Eigen::RowVector3d up = e.cross(Eigen::RowVector3d(0, 0, 1)).normalized().cross(e);
-  for (int kind = 0; kind < 4; ++kind) {
-    CAPTURE(kind);  // sliver 1e-9 m, zero area, coincident vertices, collapsed to a point
-    Points3 p = base;
-    if (kind < 2) p.row(a) = 0.5 * (p.row(b) + p.row(c)) + (kind == 0 ? 1e-9 : 0.0) * up;
-    if (kind >= 2) p.row(c) = p.row(b);
-    if (kind == 3) p.row(a) = p.row(b);
-    const std::vector<double> n = vertex_norms(p);
+  for (const gdsr_test::DegenerateCase& dc : gdsr_test::degenerate_cases(base, a, b, c)) {
+    const std::string& name = dc.name;
+    INFO(name);
+    const std::vector<double> n = vertex_norms(dc.P);
     const double worst = std::max({n[a], n[b], n[c]});
-    MESSAGE("case " << kind << ": " << worst / median << " x the healthy median");
+    MESSAGE(name << ": " << worst / median << " x the healthy median");
     CHECK(std::isfinite(worst));
     CHECK(worst < 100 * median);
   }
