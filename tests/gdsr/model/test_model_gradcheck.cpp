@@ -41,18 +41,24 @@ struct Setup {
 
 namespace {
 
-// The whole-model check in units s x metre: the model converted with
-// gdsr_test::model_in_units, its graph, frame and positions scaled by s. The relative errors
-// must be those at s = 1 (steps are relative to each input's largest entry); the absolute
-// floor below which gradients are judged by their absolute error scales with them (a
-// parameter of unit power p gets s^(1 - p) x its gradient in metres).
-void check_whole_model(double s) {
+enum class Units {
+  converted,  // the model converted to units of s metres (gdsr_test::model_in_units)
+  raw         // the metre model given positions x s (a garment in the wrong units)
+};
+
+// The whole-model check with the graph, frame and positions scaled by s. Converted, the
+// relative errors must be those at s = 1 (steps are relative to each input's largest entry);
+// the absolute floor below which gradients are judged by their absolute error scales with
+// them (a parameter of unit power p gets s^(1 - p) x its gradient in metres). Raw, the model
+// meets features 1e3 x larger or smaller than in training: its gradients must still be right.
+void check_whole_model(double s, Units units) {
+  const bool convert = units == Units::converted;
   Setup S;
   // E's bias starts at 0, where gradcheck's step falls back to an absolute 1e-5 (no scale to
   // be relative to), which is not the same step in other units: give it a size in metres.
   S.model.e().bias.values() = {0.02, -0.03, 0.01};
   const std::unique_ptr<GDSR<double>> converted = gdsr_test::model_in_units(S.model, s);
-  GDSR<double>& model = *converted;
+  GDSR<double>& model = convert ? *converted : S.model;
   GarmentMesh rest = S.garment;
   rest.V *= s;
   const GarmentGraph g = build_graph(rest);
@@ -74,13 +80,16 @@ void check_whole_model(double s) {
   auto f = [&](const std::vector<ag::Tensord>& x) {
     // Parameters are the model's own tensors (perturbed in place by gradcheck).
     const auto out = model.forward(g, x.back(), in, &hr);
-    REQUIRE(out.features.layer_edges.size() > 0);
+    // (raw: at x1e3 the layers are beyond sigma_l, at x1e-3 every pair is a layer edge)
+    if (convert) REQUIRE(out.features.layer_edges.size() > 0);
     return ag::concat_rows<double>({out.C_hat, out.G});
   };
   ag::sum(f({C})).backward();
-  // Gradients in metres' terms: divided by s^(1 - p) (p: unit power of the tensor; mixed
-  // only in h.node_pre.0.linear1.weight, whose metric columns dominate its gradient).
-  auto metre_factor = [&](const std::string& name) { return std::pow(s, 1 - gdsr_test::unit_power(name, 3)); };
+  // Converted gradients in metres' terms: divided by s^(1 - p) (p: unit power of the tensor;
+  // mixed only in h.node_pre.0.linear1.weight, whose metric columns dominate its gradient).
+  auto metre_factor = [&](const std::string& name) {
+    return convert ? std::pow(s, 1 - gdsr_test::unit_power(name, 3)) : 1.0;
+  };
   double largest_all = 0;
   for (const auto& [name, t] : model.named_parameters())
     if (t.has_grad())
@@ -121,8 +130,10 @@ void check_whole_model(double s) {
     CAPTURE(p);
     // Entries below 1e-3 (in metres' terms) are judged by absolute error: the loss sums 117
     // outputs, and its central differences carry round-off near 1e-8 (seen: analytic -1.8e-13
-    // vs numeric -8.1e-9 on a parameter whose other gradients are ~1e-1).
-    opt.abs_floor = 1e-3 * std::pow(s, 1 - p);
+    // vs numeric -8.1e-9 on a parameter whose other gradients are ~1e-1). Raw, that round-off
+    // grows with the outputs' size, max(E's ~0.1 m, s x the garment): 1e-3 x max(1, s) (at
+    // x1e3 a floor of 1e-3 fails at 5.8e-5 on entries of 4e-5, round-off).
+    opt.abs_floor = convert ? 1e-3 * std::pow(s, 1 - p) : 1e-3 * std::max(1.0, s);
     // h.node_pre.0.linear1.weight has unit-free columns (the normal) next to metric ones: in
     // other units their sizes differ by s, so each column gets its own step.
     opt.per_column = p == -1;
@@ -139,7 +150,7 @@ void check_whole_model(double s) {
   // worst relative error falls 1.25 -> 0.22 -> 8e-3 -> 2e-7 for absolute steps 1e-4 -> 1e-5 ->
   // 1e-6 -> 1e-7 (and is 2e-6 at 1e-8, round-off): truncation error of the strongly curved
   // normalised features of a 10 cm garment (channel norm over 18 vertices), not a wrong
-  // gradient. d(outputs)/dC is unit-free: the floor stays 1e-3.
+  // gradient. d(outputs)/dC is unit-free: the floor stays 1e-3 (raw too).
   ag::GradCheckOptions opt_c = opt;
   opt_c.step = 1e-7;
   opt_c.abs_floor = 1e-3;
@@ -152,12 +163,17 @@ void check_whole_model(double s) {
 
 TEST_CASE("model gradcheck: whole GDSR model, tiny preset, float64") {
   // Parameters and C; the body-interaction features are off here (see check_whole_model).
-  check_whole_model(1.0);
+  check_whole_model(1.0, Units::converted);
 }
 
 TEST_CASE("model gradcheck: whole GDSR model in mm and km units (positions x1e3 and x1e-3)") {
-  check_whole_model(1e3);
-  check_whole_model(1e-3);
+  check_whole_model(1e3, Units::converted);
+  check_whole_model(1e-3, Units::converted);
+}
+
+TEST_CASE("model gradcheck: the metre model on positions x1e3 and x1e-3 without conversion") {
+  check_whole_model(1e3, Units::raw);
+  check_whole_model(1e-3, Units::raw);
 }
 
 // The same check piece by piece with respect to C only (localises a failure).
