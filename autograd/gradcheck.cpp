@@ -70,39 +70,47 @@ GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>
     }
     const std::vector<double> analytic = x.has_grad() ? x.grad() : std::vector<double>(static_cast<size_t>(n), 0.0);
 
-    double scale = 0;  // the input's size: steps and the floor are relative to it
-    for (double v : x.values()) scale = std::max(scale, std::abs(v));
-    if (!(scale > 0) || !std::isfinite(scale)) scale = 1;
+    // Groups judged together: the whole input, or each column of a 2-D input.
+    const int64_t cols = opt.per_column && x.dim() == 2 ? x.cols() : 1;
+    for (int64_t c = 0; c < cols; ++c) {
+      std::vector<int64_t> group;
+      for (int64_t i : entries)
+        if (i % cols == c) group.push_back(i);
+      if (group.empty()) continue;
+      double scale = 0;  // the group's size: steps and the floor are relative to it
+      for (int64_t i = c; i < n; i += cols) scale = std::max(scale, std::abs(x.values()[static_cast<size_t>(i)]));
+      if (!(scale > 0) || !std::isfinite(scale)) scale = 1;
 
-    std::vector<double> numeric(entries.size());
-    for (size_t e = 0; e < entries.size(); ++e) {
-      double& v = x.values()[static_cast<size_t>(entries[e])];
-      const double orig = v;
-      const double h = opt.step * scale;
-      const double xp = orig + h, xm = orig - h;
-      v = xp;
-      const double lp = loss_value();
-      v = xm;
-      const double lm = loss_value();
-      v = orig;
-      numeric[e] = (lp - lm) / (xp - xm);
-    }
-    double largest = 0;
-    for (double v : numeric) largest = std::max(largest, std::abs(v));
-    const double floor = std::max({opt.floor_fraction * largest, opt.abs_floor, 1e-12 * loss_magnitude / scale,
-                                   std::numeric_limits<double>::min()});
-    for (size_t e = 0; e < entries.size(); ++e) {
-      const double a = analytic[static_cast<size_t>(entries[e])], nu = numeric[e];
-      double rel = std::abs(a - nu) / std::max({std::abs(a), std::abs(nu), floor});
-      if (std::isnan(rel)) rel = INFINITY;  // a NaN gradient is the worst error
-      if (res.input < 0 || rel > res.max_rel_error) {
-        res.max_rel_error = rel;
-        res.input = static_cast<int>(k);
-        res.element = entries[e];
-        res.analytic = a;
-        res.numeric = nu;
+      std::vector<double> numeric(group.size());
+      for (size_t e = 0; e < group.size(); ++e) {
+        double& v = x.values()[static_cast<size_t>(group[e])];
+        const double orig = v;
+        const double h = opt.step * scale;
+        const double xp = orig + h, xm = orig - h;
+        v = xp;
+        const double lp = loss_value();
+        v = xm;
+        const double lm = loss_value();
+        v = orig;
+        numeric[e] = (lp - lm) / (xp - xm);
       }
-      ++res.checked;
+      double largest = 0;
+      for (double v : numeric) largest = std::max(largest, std::abs(v));
+      const double floor = std::max({opt.floor_fraction * largest, opt.abs_floor, 1e-12 * loss_magnitude / scale,
+                                     std::numeric_limits<double>::min()});
+      for (size_t e = 0; e < group.size(); ++e) {
+        const double a = analytic[static_cast<size_t>(group[e])], nu = numeric[e];
+        double rel = std::abs(a - nu) / std::max({std::abs(a), std::abs(nu), floor});
+        if (std::isnan(rel)) rel = INFINITY;  // a NaN gradient is the worst error
+        if (res.input < 0 || rel > res.max_rel_error) {
+          res.max_rel_error = rel;
+          res.input = static_cast<int>(k);
+          res.element = group[e];
+          res.analytic = a;
+          res.numeric = nu;
+        }
+        ++res.checked;
+      }
     }
   }
   return res;

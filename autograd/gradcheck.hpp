@@ -36,6 +36,10 @@ struct GradCheckOptions {
   // abs_floor says below which size entries are judged by their absolute error instead.
   double abs_floor = 0;
   int64_t max_entries_per_input = 400;  // larger inputs: a deterministic random subset
+  // 2-D inputs: each column is judged as an input of its own (its own scale for the step and
+  // the floors), for tensors whose columns hold quantities of different sizes or units (e.g.
+  // a first-layer weight on unit-free and metric features).
+  bool per_column = false;
   unsigned seed = 1;
 };
 

@@ -12,6 +12,8 @@ namespace ag {
 template <class T> Tensor<T> add(const Tensor<T>& a, const Tensor<T>& b);
 template <class T> Tensor<T> sub(const Tensor<T>& a, const Tensor<T>& b);
 template <class T> Tensor<T> mul(const Tensor<T>& a, const Tensor<T>& b);
+// div needs b != 0: b = 0 gives inf (NaN for 0 / 0) and so do its gradients 1 / b and
+// -a / b^2, the latter already once |a| / b^2 exceeds the largest float.
 template <class T> Tensor<T> div(const Tensor<T>& a, const Tensor<T>& b);
 template <class T> Tensor<T> neg(const Tensor<T>& a);
 template <class T> Tensor<T> add_scalar(const Tensor<T>& a, T s);
@@ -29,7 +31,7 @@ template <class T> Tensor<T> operator*(T s, const Tensor<T>& a) { return mul_sca
 
 // Real scalar types only (float, double). Valid input ranges follow IEEE arithmetic; where a
 // value or gradient leaves the float range it becomes inf or NaN (never clamped silently):
-// exp overflows above ~88.7 (float32) / ~709.8 (float64).
+// exp (and its gradient, exp itself) overflows above ~88.7 (float32) / ~709.8 (float64).
 template <class T> Tensor<T> exp(const Tensor<T>& x);
 // Needs x > 0: log(0) = -inf with gradient +inf, log(x < 0) = NaN.
 template <class T> Tensor<T> log(const Tensor<T>& x);
@@ -41,11 +43,14 @@ template <class T> Tensor<T> cos(const Tensor<T>& x);
 template <class T> Tensor<T> tanh(const Tensor<T>& x);
 template <class T> Tensor<T> abs(const Tensor<T>& x);  // d|x|/dx at 0 taken as 0
 template <class T> Tensor<T> square(const Tensor<T>& x);
-template <class T> Tensor<T> pow(const Tensor<T>& x, T p);  // x^p; for non-integer p needs x > 0 (NaN below)
+// x^p; for non-integer p needs x > 0 (NaN below), and for p < 1 the gradient p x^(p-1) is
+// inf at x = 0 (as sqrt's).
+template <class T> Tensor<T> pow(const Tensor<T>& x, T p);
 template <class T> Tensor<T> relu(const Tensor<T>& x);
 template <class T> Tensor<T> leaky_relu(const Tensor<T>& x, T slope);
 template <class T> Tensor<T> sigmoid(const Tensor<T>& x);
-template <class T> Tensor<T> clamp(const Tensor<T>& x, T lo, T hi);          // gradient 0 outside [lo, hi]
+// Needs lo <= hi (ag::Error otherwise); gradient 0 outside [lo, hi], 1 on its ends.
+template <class T> Tensor<T> clamp(const Tensor<T>& x, T lo, T hi);
 // Same shapes; grad at (0,0) taken as 0. Valid for all finite y, x: the gradient is scaled
 // first (as hypot), exact down to subnormal and up to near-overflow magnitudes.
 template <class T> Tensor<T> atan2(const Tensor<T>& y, const Tensor<T>& x);

@@ -6,7 +6,8 @@
 
 namespace ag {
 
-template <class T> Tensor<T> l1_loss(const Tensor<T>& pred, const Tensor<T>& target);   // mean |p - t|
+// mean |p - t|; gradient sign(p - t) / n, 0 where p = t. Both need n > 0 (ag::Error).
+template <class T> Tensor<T> l1_loss(const Tensor<T>& pred, const Tensor<T>& target);
 template <class T> Tensor<T> mse_loss(const Tensor<T>& pred, const Tensor<T>& target);  // mean (p - t)^2
 
 }  // namespace ag

@@ -1,4 +1,5 @@
-// Reductions over a 2-D tensor [R x C]. (sum and mean accept any rank.)
+// Reductions over a 2-D tensor [R x C]. (sum and mean accept any rank.) The means need a
+// non-empty extent (ag::Error on 0 elements, where the mean is undefined).
 #pragma once
 
 #include "autograd/tensor.hpp"

@@ -96,7 +96,7 @@ template <class T> CoarseLoss<T> coarse_loss(const LossConfig& cfg, const MeshTo
   }
   if (cfg.c_dihedral.on && !lr.pair_f0.empty()) {
     const ag::Tensor<T> agt = no_grad<T>([&] { return dihedral_angles(gt, lr); });
-    // |angle - gt| weighted by |n0| |n1| of the prediction: 1 on healthy pairs (the plain L1),
+    // |angle - gt| weighted by the prediction's fade weight: 1 on healthy pairs (the plain L1),
     // and a bounded gradient on predicted slivers (see dihedral_terms).
     const DihedralTerms<T> d = dihedral_terms(C_hat, lr);
     const ag::Tensor<T> l = ag::mean(ag::mul(d.weight, ag::abs(ag::sub(d.angle, agt))));

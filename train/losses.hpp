@@ -4,9 +4,10 @@
 //   w_pos L1(C^, C*) + w_nrm L1(N(C^), N(C*)) + w_str strain + w_smo smoothness(C^)
 //   + w_dih L1(theta(C^), theta(C*)),  defaults 1, 0.01, 0.01, 100, 0.003.
 //   strain = L1(|F_u|) + L1(|F_v|) + L1(F^_u . F^_v) against the ground truth's (each a mean
-//   over faces). L1 = mean absolute difference over all elements, except that the dihedral
-//   term weights each pair by |n0| |n1| of C^'s eps-normalised normals (1 on healthy pairs,
-//   smaller on predicted slivers, whose angle gradient 1 / height would otherwise dominate).
+//   over faces; shear with the floor kShearEps, geometry_ad.hpp). L1 = mean absolute
+//   difference over all elements, except that the dihedral term weights each pair by the
+//   weight of dihedral_terms (exactly 1 on faces with at least 1% of their rest area, fading
+//   with the area below: a predicted sliver's angle gradient 1 / height would dominate).
 // Fine, over a PatchBatch of P patches (the reference's batching):
 //   w_pos L1(inside positions of all patches) + w_nm [w_vgg VGG(images) + w_l1 L1(images)]
 //   + w_str (sum_p strain_p) / P + w_smo (sum_p smoothness_p) / P,

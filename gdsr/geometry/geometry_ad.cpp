@@ -78,6 +78,7 @@ MeshTopology make_topology(const Faces& F, int num_vertices, const Points2& UV, 
 
   double area_sum = 0;
   int area_count = 0;
+  std::vector<double> area2(static_cast<size_t>(nf), -1.0);  // doubled rest area, -1 unknown
   if (UV.rows() > 0) {
     if (FUV.rows() != F.rows())
       gdsr::fail("geometry_ad", "FUV has " + std::to_string(FUV.rows()) + " faces, F has " + std::to_string(F.rows()));
@@ -92,6 +93,7 @@ MeshTopology make_topology(const Faces& F, int num_vertices, const Points2& UV, 
         ++t.num_degenerate_uv;
         continue;
       }
+      area2[f] = std::abs(det);
       area_sum += std::abs(det);
       ++area_count;
       t.strain_faces.push_back(f);
@@ -109,7 +111,8 @@ MeshTopology make_topology(const Faces& F, int num_vertices, const Points2& UV, 
       const Vec3 a = rest3d->row(F(f, 0)).transpose(), b = rest3d->row(F(f, 1)).transpose(),
                  c = rest3d->row(F(f, 2)).transpose();
       const double d = (b - a).cross(c - a).norm();
-      if (d > 0) {
+      if (d > 0 && std::isfinite(d)) {
+        area2[f] = d;
         area_sum += d;
         ++area_count;
       }
@@ -119,6 +122,12 @@ MeshTopology make_topology(const Faces& F, int num_vertices, const Points2& UV, 
     t.normal_eps = normal_eps;
   else
     t.normal_eps = area_count > 0 ? 1e-6 * area_sum / area_count : 1e-12;
+  // Without any rest shape the mean doubled area is taken as normal_eps / 1e-6 (1e-6 m^2 when
+  // that is the absolute fallback).
+  const double mean_area2 = area_count > 0 ? area_sum / area_count : t.normal_eps / 1e-6;
+  t.dihedral_floor.resize(static_cast<size_t>(nf));
+  for (int f = 0; f < nf; ++f)
+    t.dihedral_floor[f] = kDihedralFade * (area2[f] > 1e-8 * mean_area2 ? area2[f] : mean_area2);
   return t;
 }
 
@@ -158,7 +167,7 @@ template <class T> UVGradient<T> uv_gradient(const ag::Tensor<T>& X, const MeshT
 
 template <class T> ag::Tensor<T> strain_measures(const ag::Tensor<T>& X, const MeshTopology& t) {
   const UVGradient<T> g = uv_gradient(X, t);
-  const T eps = static_cast<T>(1e-6);
+  const T eps = static_cast<T>(kShearEps);
   const ag::Tensor<T> shear = ag::dot_rows(ag::normalize_rows(g.Fu, eps), ag::normalize_rows(g.Fv, eps));
   return ag::concat_cols<T>({ag::norm_rows(g.Fu), ag::norm_rows(g.Fv), shear});
 }
@@ -192,12 +201,16 @@ template <class T> ag::Tensor<T> smoothness(const ag::Tensor<T>& X, const MeshTo
 
 template <class T> DihedralTerms<T> dihedral_terms(const ag::Tensor<T>& X, const MeshTopology& t) {
   if (t.pair_f0.empty()) gdsr::fail("geometry_ad", "dihedral_angles: mesh has no adjacent face pairs");
-  const ag::Tensor<T> n = face_normals(X, t);
+  const ag::Tensor<T> c = face_cross(X, t);
+  const ag::Tensor<T> n = ag::normalize_rows(c, static_cast<T>(t.normal_eps));
   const ag::Tensor<T> n0 = ag::index_select_rows(n, t.pair_f0);
   const ag::Tensor<T> n1 = ag::index_select_rows(n, t.pair_f1);
   DihedralTerms<T> d;
   d.angle = ag::atan2(ag::norm_rows(ag::cross3(n0, n1)), ag::dot_rows(n0, n1));
-  d.weight = ag::mul(ag::norm_rows(n0), ag::norm_rows(n1));
+  std::vector<T> floor(t.dihedral_floor.begin(), t.dihedral_floor.end());
+  const ag::Tensor<T> s = ag::clamp(ag::div(ag::norm_rows(c), ag::Tensor<T>::from({t.num_faces, 1}, std::move(floor))),
+                                    T(0), T(1));
+  d.weight = ag::mul(ag::index_select_rows(s, t.pair_f0), ag::index_select_rows(s, t.pair_f1));
   return d;
 }
 

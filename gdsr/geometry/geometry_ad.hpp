@@ -37,7 +37,15 @@ struct MeshTopology {
   std::vector<double> dm_inv;  // 4 per strain face
   int num_degenerate_uv = 0;
   double normal_eps = 1e-12;  // metres^2 (see header comment)
+  // Per face: kDihedralFade x its doubled rest area (metres^2; the mesh's mean for a face
+  // whose rest shape is degenerate), where the dihedral weight starts to fade (dihedral_terms).
+  std::vector<double> dihedral_floor;
 };
+
+// Faces compressed below this fraction of their rest area fade out of the dihedral loss.
+constexpr double kDihedralFade = 1e-2;
+// Floor of |F_u| and |F_v| in the shear measure (dimensionless: a stretch of 1 is rest).
+constexpr double kShearEps = 1e-2;
 
 // F: faces x 3 into X's rows (num_vertices rows). UV / FUV: flat rest shape (metres); face f
 // is FUV.row(f) in UV. Pass UV empty (0 rows) for no strain data. normal_eps <= 0: automatic
@@ -59,7 +67,11 @@ template <class T> ag::Tensor<T> vertex_normals(const ag::Tensor<T>& X, const Me
 template <class T> struct UVGradient { ag::Tensor<T> Fu, Fv; };
 template <class T> UVGradient<T> uv_gradient(const ag::Tensor<T>& X, const MeshTopology& t);
 // Strain measures per strain face, [S x 3]: |F_u|, |F_v|, normalize(F_u) . normalize(F_v)
-// (normalize with eps 1e-6, as the reference).
+// with normalize(a) = a / max(|a|, kShearEps). The reference uses eps 1e-6, which lets a face
+// collapsed along u or v (coincident vertices: F_v = 0) have a shear gradient of 1e6 |Dm^-1|,
+// 1e5 x every other vertex's gradient of the whole coarse loss; 1e-2 bounds it by ~2 |Dm^-1|
+// / 1e-2 and changes nothing on faces stretched to at least 1% of their rest size along u and
+// v (all of cloth's healthy range).
 template <class T> ag::Tensor<T> strain_measures(const ag::Tensor<T>& X, const MeshTopology& t);
 
 // Smoothness residual [V x 3]: x_v - mean of the centroids of v's faces (0 rows for
@@ -72,11 +84,14 @@ ag::Tensor<T> smoothness(const ag::Tensor<T>& X, const MeshTopology& t, const ag
 
 // Dihedral angle per adjacent face pair, [P x 1], radians in [0, pi].
 template <class T> ag::Tensor<T> dihedral_angles(const ag::Tensor<T>& X, const MeshTopology& t);
-// The angles and, per pair, weight = |n0| |n1| [P x 1] of the face normals above: 1 (to
-// rounding) for pairs of healthy faces, falling to 0 as either face degenerates (|cross| <
-// normal_eps). The angle's own gradient is 1 / height on a sliver (3e6 at 1e-9 m high);
-// weight * angle has a gradient bounded by ~ edge / normal_eps, so a sliver cannot
-// dominate a dihedral loss.
+// The angles and, per pair, weight = s0 s1 [P x 1] with s = min(1, |cross| / dihedral_floor)
+// per face: exactly 1 (gradient 0) for pairs of faces with at least kDihedralFade of their
+// rest area, falling linearly with the area to 0 as either face degenerates. The angle's own
+// gradient is 1 / height on a sliver (1e9 at 1e-9 m high) and is undefined at zero area;
+// weight * angle has a gradient bounded by ~ (1 + pi) edge / dihedral_floor ~ (1 + pi) /
+// (kDihedralFade x rest height), i.e. ~400 x a healthy face's angle gradient, whatever the
+// sliver (the former |n0| |n1| weighting, which fades only below normal_eps, still let a
+// 1e-9 m sliver's gradient reach 7e4 x every other vertex's gradient of the coarse loss).
 template <class T> struct DihedralTerms {
   ag::Tensor<T> angle, weight;
 };

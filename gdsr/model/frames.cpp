@@ -4,6 +4,7 @@
 
 #include "autograd/autograd.hpp"
 
+#include <limits>
 #include <stdexcept>
 
 namespace gdsr {
@@ -67,6 +68,7 @@ template <class T> ag::Tensor<T> local_to_world(const ag::Tensor<T>& r, const ag
 }
 
 template <class T> ag::Tensor<T> vertex_normals_ad(const ag::Tensor<T>& X, const Faces& F, T eps) {
+  if (!(eps > T(0))) gdsr::fail("vertex_normals_ad", "eps must be > 0 (a fraction of the vertex's area)");
   ag::Index all(F.rows());
   for (int64_t f = 0; f < F.rows(); ++f) all[f] = f;
   const ag::Tensor<T> v0 = ag::index_select_rows(X, face_column(F, all, 0));
@@ -78,7 +80,19 @@ template <class T> ag::Tensor<T> vertex_normals_ad(const ag::Tensor<T>& X, const
   for (int64_t f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) corner_face[3 * f + k] = f, corner_vertex[3 * f + k] = F(f, k);
   const ag::Tensor<T> sum = ag::scatter_add_rows(ag::index_select_rows(c, corner_face), corner_vertex, X.rows());
-  return ag::normalize_rows(sum, eps);
+  // The floor scales with the vertex's own area (an absolute eps would shrink the normals of
+  // a mesh in small units). Formed as unit(sum) * min(1, |sum| / floor): on every vertex above
+  // the floor the factor is exactly 1 with gradient 0, so the normals and their gradients are
+  // bit-identical to a plain normalisation there.
+  const ag::Tensor<T> area = ag::scatter_add_rows(ag::index_select_rows(ag::norm_rows(c), corner_face), corner_vertex,
+                                                  X.rows());
+  const ag::Tensor<T> floor = ag::mul_scalar(area, eps);
+  std::vector<T> point(static_cast<size_t>(X.rows()));  // floor 0 (no area at all): divide by 1
+  for (int64_t r = 0; r < X.rows(); ++r) point[r] = floor.data()[r] == T(0) ? T(1) : T(0);
+  const ag::Tensor<T> shrink =
+      ag::clamp(ag::div(ag::norm_rows(sum), ag::add(floor, ag::Tensor<T>::from({X.rows(), 1}, std::move(point)))),
+                T(0), T(1));
+  return ag::mul(ag::normalize_rows(sum, std::numeric_limits<T>::min()), shrink);
 }
 
 #define INSTANTIATE(T)                                                                                   \

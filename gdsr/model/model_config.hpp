@@ -39,7 +39,7 @@ struct ModelConfig {
   double sigma_b = 0.015;    // body interaction distance, m
   double sigma_l = 0.020;    // layer-edge distance, m
   double noise_std = 0.003;  // training noise on the history features, m
-  double frame_eps = 1e-3;   // local-frame normalisation eps, relative to each triangle's size
+  double frame_eps = 1e-2;   // local-frame normalisation eps, relative to each triangle's size (frames.hpp)
 
   uint64_t seed = 1;  // parameter initialisation
 

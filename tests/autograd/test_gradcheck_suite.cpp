@@ -43,3 +43,30 @@ TEST_CASE("gradcheck: a planted 2x-wrong gradient is caught at input scales 1e-2
     CHECK_MESSAGE(smooth.max_rel_error < 1e-6, smooth.report());
   }
 }
+
+TEST_CASE("gradcheck: per_column judges each column at its own scale") {
+  // Column 0 ~ 1, column 1 ~ 1e-6, each curved on its own scale: one step for the whole input
+  // (1e-6 x the largest entry) is as large as the small column itself, per column it is not.
+  const ag::Tensord x = ag::Tensord::from({3, 2}, {0.5, 0.4e-6, -1.0, -0.9e-6, 0.8, 1.2e-6});
+  const ag::Tensord k = ag::Tensord::from({1, 2}, {1.0, 1e6});
+  auto f = [&](const std::vector<ag::Tensord>& in) { return ag::tanh(ag::mul(in[0], k)); };
+  const auto whole = ag::gradcheck(f, {x});
+  INFO(whole.report());
+  CHECK(whole.max_rel_error > 1e-3);
+  ag::GradCheckOptions opt;
+  opt.per_column = true;
+  const auto cols = ag::gradcheck(f, {x}, opt);
+  INFO(cols.report());
+  CHECK(cols.max_rel_error < 1e-6);
+  CHECK(cols.checked == 6);
+  // and a wrong gradient in the small column is still caught
+  const ag::Tensord mask = ag::Tensord::from({1, 2}, {0.0, 1.0});
+  const auto wrong = ag::gradcheck(
+      [&](const std::vector<ag::Tensord>& in) {
+        return ag::add(f(in), ag::mul(ag::mul(in[0], in[0].detach()), ag::mul_scalar(mask, 1e12)));
+      },
+      {x}, opt);
+  INFO(wrong.report());
+  CHECK(wrong.max_rel_error > 0.1);
+  CHECK(wrong.element % 2 == 1);
+}

@@ -4,7 +4,9 @@
 #include "gdsr/geometry/mesh.hpp"
 #include "tests/support/grid_garment.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace gdsr_test {
@@ -38,6 +40,45 @@ inline gdsr::GarmentMesh cut_garment(int n, double h) {
   g.F = F;
   g.FUV = F;
   return g;
+}
+
+// P with vertex a moved onto the midpoint of edge (b, c) and lifted by h (metres) across the
+// edge, in the plane of the edge and the z axis: triangle (a, b, c) becomes a sliver of height h.
+inline gdsr::Points3 sliver(const gdsr::Points3& P, int a, int b, int c, double h) {
+  gdsr::Points3 Q = P;
+  const Eigen::RowVector3d e = (P.row(c) - P.row(b)).normalized();
+  const Eigen::RowVector3d up = e.cross(Eigen::RowVector3d(0, 0, 1)).normalized().cross(e);
+  Q.row(a) = 0.5 * (P.row(b) + P.row(c)) + h * up;
+  return Q;
+}
+
+// The degenerate versions of triangle (a, b, c) of P a predicted mesh can contain: a 1e-9 m
+// sliver, zero area (a on edge b c), coincident vertices (c = b), collapsed to a point.
+struct DegenerateCase {
+  std::string name;
+  gdsr::Points3 P;
+};
+inline std::vector<DegenerateCase> degenerate_cases(const gdsr::Points3& P, int a, int b, int c) {
+  std::vector<DegenerateCase> out{{"sliver of 1e-9 m", sliver(P, a, b, c, 1e-9)}, {"zero area", sliver(P, a, b, c, 0.0)}};
+  gdsr::Points3 Q = P;
+  Q.row(c) = Q.row(b);
+  out.push_back({"coincident vertices", Q});
+  Q.row(a) = Q.row(b);
+  out.push_back({"collapsed to a point", Q});
+  return out;
+}
+
+// |dL/dx_v| per vertex of a flat [V x 3] gradient.
+inline std::vector<double> vertex_norms(const std::vector<double>& grad) {
+  std::vector<double> n(grad.size() / 3);
+  for (size_t i = 0; i < n.size(); ++i)
+    n[i] = std::sqrt(grad[3 * i] * grad[3 * i] + grad[3 * i + 1] * grad[3 * i + 1] + grad[3 * i + 2] * grad[3 * i + 2]);
+  return n;
+}
+
+inline double median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
 }
 
 }  // namespace gdsr_test

@@ -8,6 +8,8 @@
 #include "nn/rng.hpp"
 
 #include <cmath>
+#include <memory>
+#include <string>
 
 namespace gdsr_test {
 
@@ -66,6 +68,54 @@ inline gdsr::TriMesh plane_body(double y, double h = 10.0) {
   b.F.resize(2, 3);
   b.F << 0, 2, 1, 0, 3, 2;  // counter-clockwise seen from +y
   return b;
+}
+
+// The model in other length units: positions in the new unit are s x those in metres
+// (s = 1e3: millimetres). The model reads and writes metres by design (features in metres feed
+// H's MLPs, E and A output metres), so a change of units is a reparameterisation: every
+// length in the config (sigma_b, sigma_l, noise_std) is multiplied by s, and so are the
+// parameters that are lengths (unit_power 1: E's output scale and bias, A's field scale);
+// the first-layer weights on metric inputs (node features 3..22, every edge feature) are
+// divided by s (unit_power -1). Unit-free: normals, frames (frame_eps is relative), every
+// hidden layer. Then C_hat(s C) = s C_hat(C) and G(s C) = s G(C) exactly, to rounding.
+inline gdsr::ModelConfig config_in_units(gdsr::ModelConfig cfg, double s) {
+  cfg.sigma_b *= s;
+  cfg.sigma_l *= s;
+  cfg.noise_std *= s;
+  return cfg;
+}
+
+// The power p with which entry `col` (its column) of a parameter scales under a change of
+// units (value x s^p).
+inline int unit_power(const std::string& name, int64_t col) {
+  if (name == "e.scale" || name == "e.bias" || name == "a.field_scale") return 1;
+  if (name == "h.edge_enc.0.linear1.weight" || name == "h.layer_enc.0.linear1.weight") return -1;
+  // weight [out x in]; of the node features only columns 0..2 (the normal) are unit-free
+  if (name == "h.node_pre.0.linear1.weight") return col < 3 ? 0 : -1;
+  return 0;
+}
+
+// `model` in metres -> a model in units s x metre (constructed from config_in_units(cfg, s)).
+inline std::unique_ptr<gdsr::GDSR<double>> model_in_units(const gdsr::GDSR<double>& model, double s) {
+  auto out = std::make_unique<gdsr::GDSR<double>>(config_in_units(model.config(), s));
+  const auto src = model.named_parameters();
+  auto dst = out->named_parameters();
+  for (size_t i = 0; i < src.size(); ++i) {
+    const std::vector<double>& v = src[i].second.values();
+    std::vector<double>& d = dst[i].second.values();
+    const int64_t cols = dst[i].second.cols();
+    for (size_t j = 0; j < v.size(); ++j)
+      d[j] = v[j] * std::pow(s, unit_power(src[i].first, static_cast<int64_t>(j) % cols));
+  }
+  return out;
+}
+
+// A frame in units s x metre (positions and body points scaled, body normals unit-free).
+inline gdsr::FrameInput frame_in_units(gdsr::FrameInput in, double s) {
+  for (gdsr::Points3* P : {&in.C_t, &in.C_tm1, &in.C_tm2, &in.Chat_tm1, &in.Chat_tm2, &in.contact_t.point,
+                           &in.contact_tm1.point})
+    *P *= s;
+  return in;
 }
 
 }  // namespace gdsr_test
