@@ -1,9 +1,12 @@
 // XPBD cloth solver (substeps with a few constraint passes each). Constraints:
-// edge lengths from the flat pattern (stretch + shear against the UV rest shape), isometric
+// edge lengths from the flat pattern (stretch + shear against the UV rest shape; a shortened
+// edge is compression_ratio times softer, as woven fabric buckles below the particle
+// distance), isometric
 // bending (Bergou et al. 2006, flat rest state; by default solved implicitly, see
 // sim/cloth_bending_solve.hpp), body contact with thickness and Coulomb
 // friction against the moving body (closest body triangle, refreshed every few substeps,
-// body velocity from the frame blend), pinned vertices bound to the nearest body triangle,
+// body velocity from the frame blend; where a second body part is within reach, both, the
+// part the vertex was dressed on last, see pinch_separation), pinned vertices bound to the nearest body triangle,
 // inner/outer layer contact for multi-layer garments, long-range attachments to the pins
 // (sim/cloth_tethers.hpp), and cloth self-contact (see
 // sim/cloth_self_collision.hpp). Without a body, pinned vertices stay fixed in space. Sequential Gauss-Seidel in a
