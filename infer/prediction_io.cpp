@@ -14,6 +14,7 @@ namespace gdsr {
 void write_prediction(const std::string& dir, const Prediction& p) {
   namespace fs = std::filesystem;
   fs::create_directories(dir);
+  remove_stale_temps(dir, {"pred_hr.bin", "pred_lr.bin", "prediction.json"});  // from killed writes
   // prediction.json is the commit: it goes first and comes back last, so a kill in between
   // leaves no prediction.json beside new arrays (read_prediction refuses such a folder).
   fs::remove((fs::path(dir) / "prediction.json"));

@@ -433,10 +433,20 @@ void write_dataset(const std::string& dir, const Dataset& d) {
   const std::string name = final_dir.filename().string();
   const fs::path tmp = final_dir.parent_path() / (name + ".tmp." + pid_suffix());
   std::error_code ec;
+  remove_stale_temps(final_dir.parent_path().string(), {name});  // from killed writes
   fs::remove_all(tmp, ec);
   fs::create_directories(tmp, ec);
   if (ec) gdsr::fail("dataset", "cannot create " + tmp.string() + ": " + ec.message());
   const std::string t = tmp.string();
+  // A failed write (full disk, ...) takes its temp folder with it.
+  struct RemoveOnFailure {
+    const fs::path& dir;
+    bool done = false;
+    ~RemoveOnFailure() {
+      std::error_code e;
+      if (!done) fs::remove_all(dir, e);
+    }
+  } cleanup{tmp};
 
   write_file_atomic(join(t, "manifest.json"), manifest_json(d.manifest, d.raster).dump(2) + "\n");
   write_obj(join(t, "lr.obj"), d.lr);
@@ -482,6 +492,7 @@ void write_dataset(const std::string& dir, const Dataset& d) {
     if (had) fs::rename(old, final_dir, ec);  // put the old dataset back
     gdsr::fail("dataset", "cannot rename " + tmp.string() + " to " + final_dir.string() + ": " + why);
   }
+  cleanup.done = true;
   if (had) fs::remove_all(old, ec);
 }
 

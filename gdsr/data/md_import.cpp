@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -106,6 +108,24 @@ std::vector<ObjData> read_frame_sequence(const std::vector<std::string>& paths, 
   return out;
 }
 
+namespace {
+
+// Frames are stored as float32: a coordinate beyond its range (after `scale`) would become
+// inf in the dataset, so it is refused here, naming the file.
+void check_float_range(const std::vector<ObjData>& frames, const std::vector<std::string>& paths, double scale) {
+  for (size_t t = 0; t < frames.size(); ++t) {
+    const double m = frames[t].V.size() ? frames[t].V.cwiseAbs().maxCoeff() * scale : 0.0;
+    if (!(m <= std::numeric_limits<float>::max())) {
+      char v[32];
+      std::snprintf(v, sizeof v, "%.3g", m);
+      gdsr::fail(paths[t], std::string("coordinate of magnitude ") + v +
+                               " (after --scale) is beyond the float32 range of a dataset (3.4e38)");
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<int> weld_map(const Points3& V, double eps, int& count) {
   if (!(eps > 0)) gdsr::fail("import-md", "weld distance must be positive");
   auto key = [&](long x, long y, long z) { return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791); };
@@ -171,10 +191,11 @@ Dataset import_md(const MdImportOptions& opt) {
   int done = 0;
 
   Dataset d;
-  std::vector<ObjData> lr =
-      read_frame_sequence(list_frame_objs(opt.lr_dir), "import-md", "LR", done, total, opt.progress);
-  std::vector<ObjData> hr =
-      read_frame_sequence(list_frame_objs(opt.hr_dir), "import-md", "HR", done, total, opt.progress);
+  const std::vector<std::string> lr_paths = list_frame_objs(opt.lr_dir), hr_paths = list_frame_objs(opt.hr_dir);
+  std::vector<ObjData> lr = read_frame_sequence(lr_paths, "import-md", "LR", done, total, opt.progress);
+  std::vector<ObjData> hr = read_frame_sequence(hr_paths, "import-md", "HR", done, total, opt.progress);
+  check_float_range(lr, lr_paths, opt.scale);
+  check_float_range(hr, hr_paths, opt.scale);
   if (opt.weld > 0) {
     int n = 0;
     const std::vector<int> lm = weld_map(lr[0].V * opt.scale, opt.weld, n);
@@ -195,8 +216,9 @@ Dataset import_md(const MdImportOptions& opt) {
   lr.clear();
   hr.clear();
   if (!opt.body_dir.empty()) {
-    std::vector<ObjData> body =
-        read_frame_sequence(list_frame_objs(opt.body_dir), "import-md", "body", done, total, opt.progress);
+    const std::vector<std::string> body_paths = list_frame_objs(opt.body_dir);
+    std::vector<ObjData> body = read_frame_sequence(body_paths, "import-md", "body", done, total, opt.progress);
+    check_float_range(body, body_paths, opt.scale);
     d.body_faces = body[0].F;
     for (auto& f : body) d.body_frames.push_back(f.V * opt.scale);
   }

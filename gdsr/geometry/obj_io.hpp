@@ -7,6 +7,7 @@
 #include "gdsr/geometry/mesh.hpp"
 
 #include <string>
+#include <vector>
 
 namespace gdsr {
 
@@ -40,5 +41,10 @@ void write_obj(const std::string& path, const GarmentMesh& mesh);  // v, vt, f v
 
 // Writes `bytes` to `path` via path + ".tmp.<pid>" and a rename. Throws on any I/O error.
 void write_file_atomic(const std::string& path, const std::string& bytes);
+
+// Removes what killed writers left in `dir`: entries "<name>.tmp.<pid>" (files, or folders
+// holding only files) for each name in `names`, whose process <pid> no longer runs. A temp
+// of a running process is left alone. Best effort: errors are ignored.
+void remove_stale_temps(const std::string& dir, const std::vector<std::string>& names);
 
 }  // namespace gdsr

@@ -3,6 +3,7 @@
 #include "gdsr/model/features.hpp"
 
 #include "gdsr/error.hpp"
+#include "gdsr/geometry/obj_io.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -146,14 +147,7 @@ std::string model_config_to_json_text(const ModelConfig& c) {
 }
 
 void save_model_config(const ModelConfig& c, const std::string& path) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) gdsr::fail("model_config", "cannot write " + tmp);
-    out << model_config_to_json_text(c);
-    if (!out) gdsr::fail("model_config", "write failed for " + tmp);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) gdsr::fail("model_config", "cannot rename " + tmp + " to " + path);
+  write_file_atomic(path, model_config_to_json_text(c));
 }
 
 }  // namespace gdsr
