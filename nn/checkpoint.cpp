@@ -210,6 +210,10 @@ Checkpoint read_checkpoint(const std::string& path) {
   std::vector<uint8_t> all(static_cast<size_t>(size));
   if (size > 0) f.read(reinterpret_cast<char*>(all.data()), size);
   if (!f) throw ag::Error("checkpoint '" + path + "': read failed");
+  return parse_checkpoint(all, path);
+}
+
+Checkpoint parse_checkpoint(const std::vector<uint8_t>& all, const std::string& path) {
   if (all.size() < kHeader)
     throw ag::Error("checkpoint '" + path + "': truncated (" + std::to_string(all.size()) + " bytes, header alone is " +
                     std::to_string(kHeader) + ")");

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -115,15 +116,21 @@ nlohmann::json loss_config_to_json(const LossConfig& c) {
 LossConfig load_loss_config(const std::string& path) {
   std::ifstream in(path);
   if (!in) gdsr::fail("loss config", "cannot open " + path);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return loss_config_from_json_text(ss.str(), path);
+}
+
+LossConfig loss_config_from_json_text(const std::string& text, const std::string& path) {
   nlohmann::json j;
   try {
-    in >> j;
+    j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     gdsr::fail("loss config", std::string(path) + " is not valid JSON: " + e.what());
   }
   try {
     return loss_config_from_json(j);
-  } catch (const std::runtime_error& e) {
+  } catch (const std::exception& e) {  // gdsr::Error, or a JSON type error
     gdsr::fail(path, e.what());
   }
 }

@@ -100,8 +100,9 @@ std::string fmt(double x) {
 
 }  // namespace
 
-ObjData read_obj(const std::string& path) {
-  const std::string text = read_all(path);
+ObjData read_obj(const std::string& path) { return parse_obj(read_all(path), path); }
+
+ObjData parse_obj(const std::string& text, const std::string& path) {
   std::vector<double> v, vt;
   std::vector<int> f, ft;
   std::vector<long> cv, ct;

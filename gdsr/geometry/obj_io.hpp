@@ -23,6 +23,8 @@ struct ObjData {
 // Reads every v/vt/f line. Throws on a malformed number, an index out of range, a NaN or
 // infinite coordinate, or a file without vertices or faces.
 ObjData read_obj(const std::string& path);
+// The same on the file's bytes; `path` names the file in errors.
+ObjData parse_obj(const std::string& text, const std::string& path);
 
 // Positions and faces only.
 TriMesh read_obj_mesh(const std::string& path);
