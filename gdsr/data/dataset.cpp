@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <unistd.h>
@@ -260,6 +261,11 @@ Array parse_array(const std::string& s, const std::string& path, bool verify_che
   // that overflows 64 bits must not wrap to a small number that matches.
   uint64_t elems = 1;
   for (uint64_t d : a.dims) {
+    // Counts index int32 arrays: no dimension of a gdsr array exceeds 2^31 - 1 (and a huge
+    // one beside a zero one would pass the size check with no payload at all).
+    if (d > static_cast<uint64_t>(std::numeric_limits<int32_t>::max()))
+      gdsr::fail("dataset", std::string(path) + ": dimensions larger than the file (" + std::to_string(d) +
+                                ": corrupt header)");
     if (d != 0 && elems > s.size() / d)
       gdsr::fail("dataset", std::string(path) + ": dimensions larger than the file (truncated or corrupt header)");
     elems *= d;
@@ -293,9 +299,12 @@ std::vector<Points3> array_to_frames(const Array& a, const std::string& what) {
     gdsr::fail("dataset", std::string(what) + ": expected a float32 T x N x 3 array");
   const uint64_t T = a.dims[0], N = a.dims[1];
   const float* p = data_of<float>(a);
-  std::vector<Points3> out(T, Points3(static_cast<long>(N), 3));
-  for (uint64_t t = 0; t < T; ++t)
+  std::vector<Points3> out;
+  out.reserve(T);
+  for (uint64_t t = 0; t < T; ++t) {
+    out.emplace_back(static_cast<long>(N), 3);
     for (uint64_t i = 0; i < N * 3; ++i) out[t].data()[i] = p[t * N * 3 + i];
+  }
   return out;
 }
 

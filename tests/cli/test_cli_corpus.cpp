@@ -101,39 +101,22 @@ struct Case {
 // SIGXFSZ ignored: a longer write fails with EFBIG, as on a full disk.
 std::string full_disk(int kb) { return "trap '' XFSZ; ulimit -f " + std::to_string(2 * kb) + "; "; }
 
-void copy_dir(const TempDir& d, const std::string& from, const std::string& to) {
-  fs::copy(d / from, d / to, fs::copy_options::recursive);
-}
-// The dataset copied to {d}/bad, then `f` applied to {d}/bad.
-Setup bad_ds(std::function<void(const std::string&)> f) {
-  return [f](const TempDir& d) {
-    copy_dir(d, "ds", "bad");
-    f(d / "bad");
+// `from` (a fixture under the corpus folder, or an absolute path) copied to the scratch name
+// `to`, then `f` applied to the copy.
+Setup on_copy(const std::string& from, const std::string& to, std::function<void(const std::string&)> f) {
+  return [=](const TempDir& d) {
+    fs::copy(from[0] == '/' ? from : d / from, d / to, fs::copy_options::recursive);
+    f(d / to);
   };
 }
+Setup bad_ds(std::function<void(const std::string&)> f) { return on_copy("ds", "bad", std::move(f)); }
 Setup bad_ckpt(std::function<void(const std::string&)> f) {
-  return [f](const TempDir& d) {
-    fs::copy_file(d / "run/model.ckpt", d / "bad.ckpt");
-    f(d / "bad.ckpt");
-  };
+  return on_copy("run/model.ckpt", "bad.ckpt", std::move(f));
 }
-Setup bad_pred(std::function<void(const std::string&)> f) {
-  return [f](const TempDir& d) {
-    copy_dir(d, "pred", "badpred");
-    f(d / "badpred");
-  };
-}
-Setup bad_exports(std::function<void(const std::string&)> f) {
-  return [f](const TempDir& d) {
-    copy_dir(d, "exp_md", "badexp");
-    f(d / "badexp");
-  };
-}
+Setup bad_pred(std::function<void(const std::string&)> f) { return on_copy("pred", "badpred", std::move(f)); }
+Setup bad_exports(std::function<void(const std::string&)> f) { return on_copy("exp_md", "badexp", std::move(f)); }
 Setup bad_json(std::function<void(const std::string&)> f) {
-  return [f](const TempDir& d) {
-    fs::copy_file(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json", d / "bad.json");
-    f(d / "bad.json");
-  };
+  return on_copy(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json", "bad.json", std::move(f));
 }
 Setup text_json(const std::string& text) {
   return [text](const TempDir& d) { put(d / "bad.json", text); };
@@ -440,6 +423,7 @@ TEST_CASE("cli corpus: every bad input gets one line naming it and changes nothi
 
   const std::vector<Case> cases = corpus();
   CHECK(cases.size() >= 80);
+  MESSAGE(cases.size() << " bad inputs");
   for (const Case& c : cases) {
     for (const char* s : kScratch) fs::remove_all(d / s);
     if (c.setup) c.setup(d);
