@@ -1,12 +1,15 @@
 // Issue #15 leftovers: a failed or killed write leaves no temp behind (and a stale one does
-// not disturb the next run), the VGG weights are found from any working folder, and
-// import-md refuses coordinates a float32 dataset cannot hold.
+// not disturb the next run; a kill at any rename of a replace loses nothing), the VGG weights
+// are found from any working folder, and import-md refuses coordinates a float32 dataset
+// cannot hold.
 #include "tests/support/cli_fixtures.hpp"
 #include "tests/support/cli_run.hpp"
 #include "tests/support/data_fixtures.hpp"
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -116,4 +119,42 @@ TEST_CASE("cli writes: import-md refuses coordinates beyond the float range nami
   std::ofstream(dir / "hr/f1.obj", std::ios::trunc) << obj;
   check_one_line_error(gdsr_run(dir, import_to(dir, dir / "ds") + " --scale 100"), "f1.obj");
   CHECK_FALSE(fs::exists(dir / "ds"));
+}
+
+TEST_CASE("cli writes: a dataset replace killed at each rename keeps the old dataset and the next run recovers") {
+  // strace kills gdsr at its n-th rename(2) (fault injection), for every n of a replace.
+  if (std::system("strace -f -o /dev/null true >/dev/null 2>&1") != 0) {
+    MESSAGE("SKIPPED: strace missing or not allowed to trace here");
+    return;
+  }
+  TempDir dir("writes_kill");
+  write_exports(dir, 3);
+  const std::string cmd[2] = {import_to(dir, dir / "ds") + " --fps 30", import_to(dir, dir / "ds") + " --fps 25"};
+  std::string bytes[2];
+  for (int k = 0; k < 2; ++k) {
+    REQUIRE(gdsr_run(dir, cmd[k]).status == 0);
+    bytes[k] = folder_bytes(dir / "ds");
+  }
+  REQUIRE(bytes[0] != bytes[1]);
+  int kills = 0;
+  for (int n = 1, was = 1; n <= 40; ++n, was = 1 - was) {
+    // The folder holds dataset `was`; the other one replaces it and is killed at rename n.
+    const int now = 1 - was;
+    INFO("killed at rename " << n);
+    const Run r =
+        gdsr_run(dir, cmd[now],
+                 "strace -f -o /dev/null -e trace=rename -e inject=rename:signal=KILL:when=" + std::to_string(n) + " ");
+    if (r.status == 0) break;  // the replace has fewer than n renames
+    ++kills;
+    if (fs::exists(dir / "ds/manifest.json"))
+      CHECK(folder_bytes(dir / "ds") == bytes[was]);
+    else  // killed between "old aside" and "new in": only DIR.old.<pid> holds it
+      CHECK(count_prefixed(dir.path.string(), "ds.old.") == 1);
+    const Run next = gdsr_run(dir, cmd[now]);  // restores, sweeps the dead temp, replaces
+    CHECK(next.status == 0);
+    CHECK(folder_bytes(dir / "ds") == bytes[now]);
+    CHECK(count_prefixed(dir.path.string(), "ds.") == 0);
+  }
+  CHECK(kills == 16);  // one rename per file (14 without a body) and the two of the swap
+  MESSAGE("killed at each of " << kills << " renames");
 }
