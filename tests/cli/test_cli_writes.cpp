@@ -44,6 +44,13 @@ std::string folder_bytes(const std::string& dir) {
   return all;
 }
 
+// strace kills gdsr at its n-th rename(2) (fault injection); empty when strace cannot run.
+std::string kill_at_rename(int n) {
+  static const bool ok = std::system("strace -f -o /dev/null true >/dev/null 2>&1") == 0;
+  if (!ok) return "";
+  return "strace -f -o /dev/null -e trace=rename -e inject=rename:signal=KILL:when=" + std::to_string(n) + " ";
+}
+
 // The shell runs gdsr with files limited to `kb` KiB and SIGXFSZ ignored: a write beyond
 // fails with EFBIG, as on a full disk.
 std::string small_disk(int kb) { return "trap '' XFSZ; ulimit -f " + std::to_string(kb * 2) + "; "; }
@@ -122,8 +129,7 @@ TEST_CASE("cli writes: import-md refuses coordinates beyond the float range nami
 }
 
 TEST_CASE("cli writes: a dataset replace killed at each rename keeps the old dataset and the next run recovers") {
-  // strace kills gdsr at its n-th rename(2) (fault injection), for every n of a replace.
-  if (std::system("strace -f -o /dev/null true >/dev/null 2>&1") != 0) {
+  if (kill_at_rename(1).empty()) {
     MESSAGE("SKIPPED: strace missing or not allowed to trace here");
     return;
   }
@@ -156,5 +162,57 @@ TEST_CASE("cli writes: a dataset replace killed at each rename keeps the old dat
     CHECK(count_prefixed(dir.path.string(), "ds.") == 0);
   }
   CHECK(kills == 16);  // one rename per file (14 without a body) and the two of the swap
+  MESSAGE("killed at each of " << kills << " renames");
+}
+
+TEST_CASE(
+    "cli writes: infer killed at each rename leaves the old prediction or a refused one and the next run recovers") {
+  if (kill_at_rename(1).empty()) {
+    MESSAGE("SKIPPED: strace missing or not allowed to trace here");
+    return;
+  }
+  TempDir dir("writes_kill_infer");
+  gdsr::write_dataset(dir / "ds", gdsr_test::wave_dataset(4));
+  REQUIRE(gdsr_run(dir, "train --data '" + (dir / "ds") + "' --config '" + GDSR_SOURCE_DIR +
+                            "/configs/tiny.json' --no-vgg --patches 1 --patch-size 16 --max-steps 1 --out '" +
+                            (dir / "run") + "'")
+              .status == 0);
+  // Two predictions that differ: frames 0..3 and 1..3.
+  const std::string infer =
+      "infer --model '" + (dir / "run/model.ckpt") + "' --data '" + (dir / "ds") + "' --out '" + (dir / "pred") + "'";
+  const std::string cmd[2] = {infer, infer + " --first 1"};
+  const std::string eval = "eval --no-export --data '" + (dir / "ds") + "' --pred '" + (dir / "pred") + "'";
+  // A prediction's content: its arrays and its first frame (prediction.json also records timings).
+  auto content = [&] {
+    const std::string meta = slurp(dir / "pred/prediction.json");
+    return slurp(dir / "pred/pred_hr.bin") + slurp(dir / "pred/pred_lr.bin") +
+           meta.substr(meta.find("\"first_frame\""), 20);
+  };
+  std::string bytes[2];
+  for (int k = 0; k < 2; ++k) {
+    REQUIRE(gdsr_run(dir, cmd[k]).status == 0);
+    bytes[k] = content();
+  }
+  REQUIRE(bytes[0] != bytes[1]);
+  int kills = 0;
+  for (int n = 1, was = 1; n <= 40; ++n, was = 1 - was) {
+    const int now = 1 - was;
+    INFO("killed at rename " << n);
+    const Run r = gdsr_run(dir, cmd[now], kill_at_rename(n));
+    if (r.status == 0) break;
+    ++kills;
+    // The old prediction whole, or (killed while moving the new files in) one without
+    // prediction.json that eval refuses naming it; never a mix that eval would score.
+    const Run e = gdsr_run(dir, eval);
+    if (fs::exists(dir / "pred/prediction.json"))
+      CHECK(content() == bytes[was]);
+    else
+      CHECK(e.err.find("prediction.json") != std::string::npos);
+    const Run next = gdsr_run(dir, cmd[now]);
+    CHECK(next.status == 0);
+    CHECK(content() == bytes[now]);
+    CHECK(count_prefixed(dir.path.string(), "pred.") == 0);
+  }
+  CHECK(kills >= 6);  // the stage's files, then the moves into pred/
   MESSAGE("killed at each of " << kills << " renames");
 }
