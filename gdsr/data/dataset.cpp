@@ -5,6 +5,7 @@
 #include "nn/checkpoint.hpp"
 
 #include "gdsr/geometry/obj_io.hpp"
+#include "gdsr/model/json_value.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -195,9 +196,9 @@ template <class T> T get(const nlohmann::json& j, const std::string& key, const 
     rest = rest.substr(dot + 1);
   }
   try {
-    return p->get<T>();
+    return json_value<T>(*p);
   } catch (const std::exception&) {
-    gdsr::fail("dataset", std::string(path) + ": key '" + key + "' has the wrong type");
+    gdsr::fail("dataset", std::string(path) + ": key '" + key + "' has the wrong type or is out of range");
   }
 }
 

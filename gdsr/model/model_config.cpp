@@ -1,6 +1,7 @@
 #include "gdsr/model/model_config.hpp"
 
 #include "gdsr/model/features.hpp"
+#include "gdsr/model/json_value.hpp"
 
 #include "gdsr/error.hpp"
 #include "gdsr/geometry/obj_io.hpp"
@@ -112,7 +113,7 @@ ModelConfig model_config_from_json_text(const std::string& text, const std::stri
 #define X(name)                                  \
   if (key == #name) {                            \
     known = true;                                \
-    c.name = it.value().get<decltype(c.name)>(); \
+    c.name = json_value<decltype(c.name)>(it.value()); \
   }
       GDSR_CONFIG_FIELDS(X)
 #undef X
