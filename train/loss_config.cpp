@@ -1,6 +1,7 @@
 #include "train/loss_config.hpp"
 
 #include "gdsr/error.hpp"
+#include "gdsr/model/json_value.hpp"
 #include "nn/lr_schedule.hpp"
 
 #include <algorithm>
@@ -24,9 +25,9 @@ void check_keys(const nlohmann::json& j, const std::vector<std::string>& allowed
 template <class V> void read(const nlohmann::json& j, const char* key, V& v, const std::string& where) {
   if (!j.contains(key)) return;
   try {
-    v = j.at(key).get<V>();
-  } catch (const nlohmann::json::exception&) {
-    gdsr::fail("loss config", std::string(where) + "." + key + " has the wrong type");
+    v = json_value<V>(j.at(key));
+  } catch (const std::exception&) {  // wrong type, or a count that is not a whole number in range
+    gdsr::fail("loss config", std::string(where) + "." + key + " has the wrong type or is out of range");
   }
 }
 
