@@ -5,6 +5,7 @@
 
 #include "gdsr/error.hpp"
 #include "gdsr/cli/progress_bar.hpp"
+#include "gdsr/io/staged_folder.hpp"
 #include "infer/cmd_rollout_common.hpp"
 #include "infer/evaluate.hpp"
 #include "infer/export_rollout.hpp"
@@ -58,13 +59,16 @@ void write_report(const EvalArgs& a, const gdsr::Dataset& d, const gdsr::Predict
         "Smooth) and "
         "as a PC2 point cache on a rest OBJ (`NAME_rest.obj` + `NAME.pc2`; Blender: import the OBJ, add a Mesh "
         "Cache modifier, format PC2, frame start 0). See docs/exports.md. `export/export.json` lists them.\n");
-  const auto files = gdsr::write_eval_report(a.report, d, p, e, ro);  // checks the steps first
+  gdsr::StagedFolder out(a.report, "report.json");  // all files, or none
+  // write_eval_report checks the steps first.
+  const auto files = gdsr::write_eval_report(out.path(), d, p, e, ro);
   if (!a.no_export) {
     gdsr::RolloutExportOptions eo;
     eo.formats.obj = false;
-    gdsr::export_rollout((fs::path(a.report) / "export").string(), d, p.G, p.first_frame, eo);
+    gdsr::export_rollout((fs::path(out.path()) / "export").string(), d, p.G, p.first_frame, eo);
   }
-  if (viewer) gdsr::write_viewer(a.report, viewer_src);
+  if (viewer) gdsr::write_viewer(out.path(), viewer_src);
+  out.commit();
   std::printf("wrote report %s: %zu files (report.md, report.json, plots/, images/%s%s%s)\n", a.report.c_str(),
               files.size(), a.no_video ? "" : ", rollout.avi", a.no_export ? "" : ", export/",
               viewer ? ", viewer/" : "");
@@ -85,7 +89,9 @@ void add_eval_command(CLI::App& app) {
   CLI::App* c = app.add_subcommand("eval", "roll out (or load a prediction) and compare with the HR simulation");
   gdsr_cli::add_source_options(c, *a);
   gdsr_cli::add_rollout_options(c, *a);
-  c->add_option("--ssim-every", a->ssim_every, "SSIM on every k-th frame")->capture_default_str();
+  c->add_option("--ssim-every", a->ssim_every, "SSIM on every k-th frame")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   c->add_option("--report", a->report, "write a report folder: tables, plots, images, video, exports");
   c->add_option("--report-steps", a->image_steps,
                 "roll-out steps (1 = first frame) with images (default: 1 50 100 500 last)")

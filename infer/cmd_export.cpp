@@ -4,6 +4,7 @@
 #include "gdsr/cli/commands.hpp"
 
 #include "gdsr/error.hpp"
+#include "gdsr/io/staged_folder.hpp"
 #include "infer/cmd_rollout_common.hpp"
 #include "infer/export_rollout.hpp"
 
@@ -79,7 +80,9 @@ void add_export_command(CLI::App& app) {
     opt.formats.pc2 = has(formats, "pc2");
     opt.formats.obj = has(formats, "obj");
     opt.formats.obj_every = a->obj_every;
-    const nlohmann::json j = gdsr::export_rollout(a->out, d, p.G, p.first_frame, opt);
+    gdsr::StagedFolder out(a->out, "export.json");  // all files, or none
+    const nlohmann::json j = gdsr::export_rollout(out.path(), d, p.G, p.first_frame, opt);
+    out.commit();
     std::printf("wrote %s: frames %d..%d at %g fps (export.json)\n", a->out.c_str(), p.first_frame,
                 p.first_frame + static_cast<int>(p.G.size()) - 1, d.manifest.fps);
     for (const auto& s : j.at("sequences")) {

@@ -3,6 +3,7 @@
 #include "gdsr/data/dataset.hpp"
 #include "gdsr/error.hpp"
 #include "gdsr/geometry/obj_io.hpp"
+#include "gdsr/model/json_value.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -14,6 +15,7 @@ namespace gdsr {
 void write_prediction(const std::string& dir, const Prediction& p) {
   namespace fs = std::filesystem;
   fs::create_directories(dir);
+  remove_stale_temps(dir, {"pred_hr.bin", "pred_lr.bin", "prediction.json"});  // from killed writes
   // prediction.json is the commit: it goes first and comes back last, so a kill in between
   // leaves no prediction.json beside new arrays (read_prediction refuses such a folder).
   fs::remove((fs::path(dir) / "prediction.json"));
@@ -37,13 +39,13 @@ Prediction read_prediction(const std::string& dir, bool hr_only) {
   if (!in) gdsr::fail(meta, "cannot open (not a folder written by gdsr infer?)");
   try {
     const nlohmann::json j = nlohmann::json::parse(in);
-    p.first_frame = j.at("first_frame").get<int>();
-    frames = j.at("frames").get<long long>();
+    p.first_frame = json_value<int>(j.at("first_frame"));
+    frames = json_value<long long>(j.at("frames"));
     p.dataset = j.value("dataset", "");
     p.model = j.value("model", "");
     p.seconds_per_frame = j.value("seconds_per_frame", 0.0);
     p.model_seconds_per_frame = j.value("model_seconds_per_frame", 0.0);
-  } catch (const nlohmann::json::exception& e) {
+  } catch (const std::exception& e) {  // bad JSON, a missing key, a number out of range
     gdsr::fail(meta, e.what());
   }
   const std::string hr = (fs::path(dir) / "pred_hr.bin").string();

@@ -147,6 +147,14 @@ int write_rollout_video(const std::string& path, const Dataset& d, const std::ve
   const std::string tmp = path + ".tmp.avi";
   cv::VideoWriter video;
   int written = 0;
+  // A failure half-way (a render error, a full disk) takes the temp video with it.
+  struct RemoveOnFailure {
+    const std::string& file;
+    bool done = false;
+    ~RemoveOnFailure() {
+      if (!done) std::remove(file.c_str());
+    }
+  } cleanup{tmp};
   for (size_t k = 0; k < G.size(); k += static_cast<size_t>(every)) {
     const int t = first_frame + static_cast<int>(k);
     cv::Mat img = render_row(three_meshes(d, G[k], t), cam);
@@ -165,6 +173,7 @@ int write_rollout_video(const std::string& path, const Dataset& d, const std::ve
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
   if (ec) gdsr::fail(path, "cannot rename " + tmp + ": " + ec.message());
+  cleanup.done = true;
   return written;
 }
 

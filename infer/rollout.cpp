@@ -15,10 +15,14 @@ RolloutResult rollout(const GDSR<float>& model, const Dataset& d, const RolloutO
                       const ProgressFn& progress) {
   const int T = static_cast<int>(d.lr_frames.size());
   if (opt.first_frame < 0 || opt.first_frame >= T)
-    gdsr::fail("rollout", "first frame " + std::to_string(opt.first_frame) + " outside 0.." + std::to_string(T - 1));
+    gdsr::fail("--first",
+               std::to_string(opt.first_frame) + " is outside the input's frames 0.." + std::to_string(T - 1));
   if (opt.frames == 0 || opt.frames < -1)
-    gdsr::fail("rollout", "frame count " + std::to_string(opt.frames) + ": must be at least 1 (or -1: to the end)");
-  const int count = opt.frames < 0 ? T - opt.first_frame : std::min(opt.frames, T - opt.first_frame);
+    gdsr::fail("--frames", std::to_string(opt.frames) + ": must be at least 1 (or -1: to the end)");
+  if (opt.frames > T - opt.first_frame)
+    gdsr::fail("--frames", std::to_string(opt.frames) + " from frame " + std::to_string(opt.first_frame) +
+                               " runs past the input's " + std::to_string(T) + " frames");
+  const int count = opt.frames < 0 ? T - opt.first_frame : opt.frames;
   ag::NoGradGuard no_grad;
   const GarmentGraph graph = build_graph(d.lr);
   const HrRequest all = hr_request_all(d.corr);

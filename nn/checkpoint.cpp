@@ -210,6 +210,10 @@ Checkpoint read_checkpoint(const std::string& path) {
   std::vector<uint8_t> all(static_cast<size_t>(size));
   if (size > 0) f.read(reinterpret_cast<char*>(all.data()), size);
   if (!f) throw ag::Error("checkpoint '" + path + "': read failed");
+  return parse_checkpoint(all, path);
+}
+
+Checkpoint parse_checkpoint(const std::vector<uint8_t>& all, const std::string& path) {
   if (all.size() < kHeader)
     throw ag::Error("checkpoint '" + path + "': truncated (" + std::to_string(all.size()) + " bytes, header alone is " +
                     std::to_string(kHeader) + ")");
@@ -246,9 +250,18 @@ Checkpoint read_checkpoint(const std::string& path) {
     if (dt < 1 || dt > 5) throw ag::Error("checkpoint '" + path + "': entry '" + e.name + "' has an unknown dtype");
     e.dtype = static_cast<DType>(dt);
     const uint8_t nd = r.pod<uint8_t>();
-    for (uint8_t k = 0; k < nd; ++k) e.shape.push_back(r.pod<int64_t>());
+    // The element count, checked against the payload on the way (no signed overflow for
+    // a corrupt shape).
+    uint64_t numel = 1;
+    for (uint8_t k = 0; k < nd; ++k) {
+      const int64_t d = r.pod<int64_t>();
+      if (d < 0 || (d > 0 && numel > payload_size / static_cast<uint64_t>(d)))
+        throw ag::Error("checkpoint '" + path + "': entry '" + e.name + "' has a corrupt shape");
+      numel *= static_cast<uint64_t>(d);
+      e.shape.push_back(d);
+    }
     const uint64_t nb = r.pod<uint64_t>();
-    if (nb != static_cast<uint64_t>(ag::numel_of(e.shape)) * dtype_size(e.dtype))
+    if (nb != numel * dtype_size(e.dtype))
       throw ag::Error("checkpoint '" + path + "': entry '" + e.name + "' size does not match its shape");
     r.need(nb);
     e.bytes.assign(pl + r.pos, pl + r.pos + nb);

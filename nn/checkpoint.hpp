@@ -79,6 +79,8 @@ template <> inline DType Checkpoint::dtype_of<int64_t>() { return DType::I64; }
 // Low level: whole file <-> Checkpoint.
 void write_checkpoint(const std::string& path, const Checkpoint& ck);
 Checkpoint read_checkpoint(const std::string& path);
+// The same on the file's bytes; `path` names the file in errors.
+Checkpoint parse_checkpoint(const std::vector<uint8_t>& bytes, const std::string& path);
 
 // FNV-1a, 64 bit.
 uint64_t fnv1a64(const uint8_t* data, size_t n);

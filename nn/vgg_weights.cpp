@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 
 namespace nn {
@@ -18,7 +19,18 @@ const std::vector<std::string>& vgg19_conv_names() {
 
 std::string vgg19_default_dir() {
   if (const char* env = std::getenv("GDSR_VGG19_WEIGHTS"); env && *env) return env;
-  return "../shared/weights/vgg19-imagenet-conv1-conv3";
+  namespace fs = std::filesystem;
+  const fs::path rel = fs::path("shared") / "weights" / "vgg19-imagenet-conv1-conv3";
+  // The repository sits beside shared/ and the executable is built inside it (build/gdsr),
+  // so shared/ is a child of one of the executable's ancestors, whatever the working folder.
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec)
+    for (fs::path p = exe.parent_path(); !p.empty(); p = p.parent_path()) {
+      if (fs::exists(p / rel / "model.json", ec)) return (p / rel).string();
+      if (p == p.parent_path()) break;
+    }
+  return (fs::path("..") / rel).string();  // relative to the working folder (the old default)
 }
 
 VggWeights load_vgg19_keras(const std::string& dir) {

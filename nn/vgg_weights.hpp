@@ -32,7 +32,8 @@ struct VggWeights {
 const std::vector<std::string>& vgg19_conv_names();
 
 // The shared weights directory: $GDSR_VGG19_WEIGHTS if set, else
-// "../shared/weights/vgg19-imagenet-conv1-conv3" (relative to the working directory).
+// "<A>/shared/weights/vgg19-imagenet-conv1-conv3" for the nearest ancestor A of the running
+// executable's folder that holds it (any working folder), else that path under "..".
 std::string vgg19_default_dir();
 
 // Reads <dir>/model.json (weightsManifest) and its group files (float32 little-endian,

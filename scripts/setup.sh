@@ -9,7 +9,8 @@ packages=(g++ cmake make libeigen3-dev libassimp-dev assimp-testmodels libembree
           libcgal-dev libbenchmark-dev
           libopenmpi-dev openmpi-bin  # data-parallel training (cmake -DGDSR_MPI=ON; CI builds with it)
           blender python3-numpy  # the test that Blender opens the glTF / OBJ / PC2 exports
-          chromium)              # the test of the report's browser viewer (headless)
+          chromium               # the test of the report's browser viewer (headless)
+          strace)                # the tests that kill gdsr at each rename (fault injection)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

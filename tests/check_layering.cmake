@@ -32,6 +32,8 @@ set(rules
   "^tests/train/"          "^(autograd/|nn/|${core}|train/|tests/support/)"
   "^tests/infer/"          "^(autograd/|nn/|${core}|infer/|tests/support/)"
   "^tests/cli/"            "^(autograd/|nn/|${core}|gdsr/cli/|tests/support/)"
+  "^tests/fuzz/"           "^fuzz/"
+  "^fuzz/"                 "^(autograd/|nn/|${core}|train/loss_config\\.hpp|fuzz/)"
   "^tests/support/"        "^(autograd/|nn/|${core}|tests/support/)"
   "^bench/"                "^(autograd/|nn/|gdsr/|train/|infer/|tests/support/)"
 )

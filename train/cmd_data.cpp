@@ -256,8 +256,7 @@ void run_preview(const PreviewArgs& a) {
   if (T == 0) gdsr::fail("data preview", a.data + " has no frames");
   const int t = a.frame < 0 ? T - 1 : a.frame;
   if (t >= T)
-    gdsr::fail("data preview",
-               "frame " + std::to_string(t) + " out of range (dataset has " + std::to_string(T) + " frames)");
+    gdsr::fail("--frame", std::to_string(t) + " out of range (" + a.data + " has " + std::to_string(T) + " frames)");
   const gdsr::TriMesh lr{d.lr_frames[t], d.lr.F}, hr{d.hr_frames[t], d.hr.F};
   // One camera for both images: framed on the HR garment (and the body around it).
   gdsr::Points3 all = hr.V;
@@ -461,9 +460,9 @@ void add_data_command(CLI::App& app) {
   auto pv = std::make_shared<PreviewArgs>();
   CLI::App* prev = data->add_subcommand("preview", "render LR and HR of one frame side by side to a PNG");
   prev->add_option("--data", pv->data, "dataset folder")->required();
-  prev->add_option("--frame", pv->frame, "frame index (default: the last)");
+  prev->add_option("--frame", pv->frame, "frame index (default, -1: the last)")->check(CLI::Range(-1, 1 << 30));
   prev->add_option("--out", pv->out, "PNG file to write")->required();
-  prev->add_option("--size", pv->size, "pixels per image side")->capture_default_str();
+  prev->add_option("--size", pv->size, "pixels per image side")->capture_default_str()->check(CLI::Range(16, 8192));
   prev->add_flag("!--no-body", pv->body, "leave the body out");
   prev->add_flag("--intersections", pv->intersections, "paint faces in self-intersecting pairs (CGAL) red");
   prev->callback([pv]() { run_preview(*pv); });
@@ -482,7 +481,8 @@ void add_data_command(CLI::App& app) {
   im->add_option("--scale", imp->opt.scale, "file units to metres (0.001 for mm)")
       ->capture_default_str()
       ->check(finite_range(1e-6, 1e6));
-  im->add_option("--weld", imp->opt.weld, "merge 3-D vertices closer than this (metres) for unwelded exports");
+  im->add_option("--weld", imp->opt.weld, "merge 3-D vertices closer than this (metres) for unwelded exports")
+      ->check(finite_range(0.0, 1.0));
   im->add_option("--out", imp->out, "dataset folder to write")->required();
   im->callback([imp]() { run_import(*imp); });
 

@@ -1,10 +1,12 @@
 #include "train/loss_config.hpp"
 
 #include "gdsr/error.hpp"
+#include "gdsr/model/json_value.hpp"
 #include "nn/lr_schedule.hpp"
 
 #include <algorithm>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -23,9 +25,9 @@ void check_keys(const nlohmann::json& j, const std::vector<std::string>& allowed
 template <class V> void read(const nlohmann::json& j, const char* key, V& v, const std::string& where) {
   if (!j.contains(key)) return;
   try {
-    v = j.at(key).get<V>();
-  } catch (const nlohmann::json::exception&) {
-    gdsr::fail("loss config", std::string(where) + "." + key + " has the wrong type");
+    v = json_value<V>(j.at(key));
+  } catch (const std::exception&) {  // wrong type, or a count that is not a whole number in range
+    gdsr::fail("loss config", std::string(where) + "." + key + " has the wrong type or is out of range");
   }
 }
 
@@ -115,15 +117,21 @@ nlohmann::json loss_config_to_json(const LossConfig& c) {
 LossConfig load_loss_config(const std::string& path) {
   std::ifstream in(path);
   if (!in) gdsr::fail("loss config", "cannot open " + path);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return loss_config_from_json_text(ss.str(), path);
+}
+
+LossConfig loss_config_from_json_text(const std::string& text, const std::string& path) {
   nlohmann::json j;
   try {
-    in >> j;
+    j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     gdsr::fail("loss config", std::string(path) + " is not valid JSON: " + e.what());
   }
   try {
     return loss_config_from_json(j);
-  } catch (const std::runtime_error& e) {
+  } catch (const std::exception& e) {  // gdsr::Error, or a JSON type error
     gdsr::fail(path, e.what());
   }
 }

@@ -46,6 +46,8 @@ struct LossConfig {
 LossConfig loss_config_from_json(const nlohmann::json& j);
 nlohmann::json loss_config_to_json(const LossConfig& c);
 LossConfig load_loss_config(const std::string& path);  // throws naming the file
+// The same on the file's text; `path` names the file in errors.
+LossConfig loss_config_from_json_text(const std::string& text, const std::string& path);
 
 struct Lambdas {
   double coarse = 1, fine = 1;

@@ -114,11 +114,19 @@ RunLog::RunLog(const std::string& dir, int64_t resume_step) : dir_(dir) {
       while (std::getline(in, line)) {
         const std::vector<std::string> f = split(line);
         if (f.size() != columns().size()) continue;  // a row cut by a kill
-        const int64_t step = std::stoll(f[0]);
+        int64_t step = 0;
+        double loss = 0, val = 0;
+        try {  // a row that does not parse (cut by a kill, edited by hand) is dropped too
+          step = std::stoll(f[0]);
+          loss = std::stod(f[2]);
+          if (!f[20].empty()) val = std::stod(f[20]);
+        } catch (const std::exception&) {
+          continue;
+        }
         if (step > resume_step) continue;
         kept += line + "\n";
-        train_.push_back({step, std::stod(f[2])});
-        if (!f[20].empty()) val_.push_back({step, std::stod(f[20])});
+        train_.push_back({step, loss});
+        if (!f[20].empty()) val_.push_back({step, val});
       }
   }
   write_text_atomic(csv_path(), kept);

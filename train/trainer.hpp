@@ -39,7 +39,7 @@ struct TrainOptions {
   double lr_floor = 1e-6;
   bool fine = true;        // patches + hyper-net A (false: coarse correction only)
   bool vgg = true;         // VGG feature term of the fine loss
-  std::string vgg_dir;     // empty: ../shared/weights/vgg19-imagenet-conv1-conv3
+  std::string vgg_dir;     // empty: nn::vgg19_default_dir()
   uint64_t seed = 1;       // frame order, patches, noise
   std::string checkpoint;  // the last good state: every checkpoint_every steps and at the end ("" = never)
   int64_t checkpoint_every = 100;

@@ -5,13 +5,16 @@
 #include "nn/checkpoint.hpp"
 
 #include "gdsr/geometry/obj_io.hpp"
+#include "gdsr/model/json_value.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <unistd.h>
@@ -84,15 +87,48 @@ Array bary_array(const BaryMap& m) {
   return make_array(DType::f64, {static_cast<uint64_t>(m.size()), 3}, m.bary.data());
 }
 
-BaryMap read_bary(const std::string& dir, const std::string& stem, int n, bool verify) {
+// Barycentric weights as the writers make them: finite, summing to 1, and each within
+// [-1, 2] (a point at most about one triangle outside its triangle).
+void check_bary_row(double b0, double b1, double b2, double tol, const std::string& path, size_t row) {
+  const bool ok = std::isfinite(b0) && std::isfinite(b1) && std::isfinite(b2) && std::abs(b0 + b1 + b2 - 1) <= tol &&
+                  std::min({b0, b1, b2}) >= -1 && std::max({b0, b1, b2}) <= 2;
+  if (!ok)
+    gdsr::fail("dataset", path + ": row " + std::to_string(row) +
+                              " is not barycentric weights (NaN, out of range or not summing to 1)");
+}
+
+void check_index_range(const std::vector<int>& v, int lo, int end, const std::string& path, const char* what) {
+  for (size_t i = 0; i < v.size(); ++i)
+    if (v[i] < lo || v[i] >= end)
+      gdsr::fail("dataset", path + ": entry " + std::to_string(i) + " is " + what + " " + std::to_string(v[i]) +
+                                ", outside " + std::to_string(lo) + ".." + std::to_string(end - 1));
+}
+
+BaryMap read_bary(const std::string& dir, const std::string& stem, int n, int faces, bool verify) {
   BaryMap m;
-  const Array t = read_array(join(dir, stem + "_tri.bin"), verify);
-  expect_shape(t, DType::i32, {static_cast<uint64_t>(n)}, join(dir, stem + "_tri.bin"));
-  const Array b = read_array(join(dir, stem + "_bary.bin"), verify);
-  expect_shape(b, DType::f64, {static_cast<uint64_t>(n), 3}, join(dir, stem + "_bary.bin"));
+  const std::string tp = join(dir, stem + "_tri.bin"), bp = join(dir, stem + "_bary.bin");
+  const Array t = read_array(tp, verify);
+  expect_shape(t, DType::i32, {static_cast<uint64_t>(n)}, tp);
+  const Array b = read_array(bp, verify);
+  expect_shape(b, DType::f64, {static_cast<uint64_t>(n), 3}, bp);
   m.tri = to_ints(t);
+  check_index_range(m.tri, 0, faces, tp, "triangle");
   m.bary = Eigen::Map<const Bary>(data_of<double>(b), n, 3);
+  for (int i = 0; i < n; ++i) check_bary_row(m.bary(i, 0), m.bary(i, 1), m.bary(i, 2), 1e-6, bp, i);
   return m;
+}
+
+// Positions in metres; anything beyond 10 km is a broken file, not a garment.
+constexpr double kMaxCoordinate = 1e4;
+
+std::vector<Points3> read_frames(const std::string& path, bool verify) {
+  std::vector<Points3> f = array_to_frames(read_array(path, verify), path);
+  for (size_t t = 0; t < f.size(); ++t)
+    for (long i = 0; i < f[t].rows(); ++i)
+      if (!f[t].row(i).allFinite() || f[t].row(i).cwiseAbs().maxCoeff() > kMaxCoordinate)
+        gdsr::fail("dataset", path + ": frame " + std::to_string(t) + " vertex " + std::to_string(i) +
+                                  " is NaN, infinite or beyond 10 km");
+  return f;
 }
 
 void check_finite_frames(const std::vector<Points3>& frames, const std::string& what) {
@@ -160,9 +196,9 @@ template <class T> T get(const nlohmann::json& j, const std::string& key, const 
     rest = rest.substr(dot + 1);
   }
   try {
-    return p->get<T>();
+    return json_value<T>(*p);
   } catch (const std::exception&) {
-    gdsr::fail("dataset", std::string(path) + ": key '" + key + "' has the wrong type");
+    gdsr::fail("dataset", std::string(path) + ": key '" + key + "' has the wrong type or is out of range");
   }
 }
 
@@ -199,7 +235,10 @@ Array read_array(const std::string& path, bool verify_checksum) {
   if (!in || fs::is_directory(path)) fail_to_open(path);
   std::ostringstream ss;
   ss << in.rdbuf();
-  const std::string s = ss.str();
+  return parse_array(ss.str(), path, verify_checksum);
+}
+
+Array parse_array(const std::string& s, const std::string& path, bool verify_checksum) {
   size_t pos = 0;
   auto take = [&](void* dst, size_t n) {
     if (pos + n > s.size()) gdsr::fail("dataset", std::string(path) + ": truncated file");
@@ -223,6 +262,11 @@ Array read_array(const std::string& path, bool verify_checksum) {
   // that overflows 64 bits must not wrap to a small number that matches.
   uint64_t elems = 1;
   for (uint64_t d : a.dims) {
+    // Counts index int32 arrays: no dimension of a gdsr array exceeds 2^31 - 1 (and a huge
+    // one beside a zero one would pass the size check with no payload at all).
+    if (d > static_cast<uint64_t>(std::numeric_limits<int32_t>::max()))
+      gdsr::fail("dataset", std::string(path) + ": dimensions larger than the file (" + std::to_string(d) +
+                                ": corrupt header)");
     if (d != 0 && elems > s.size() / d)
       gdsr::fail("dataset", std::string(path) + ": dimensions larger than the file (truncated or corrupt header)");
     elems *= d;
@@ -256,9 +300,12 @@ std::vector<Points3> array_to_frames(const Array& a, const std::string& what) {
     gdsr::fail("dataset", std::string(what) + ": expected a float32 T x N x 3 array");
   const uint64_t T = a.dims[0], N = a.dims[1];
   const float* p = data_of<float>(a);
-  std::vector<Points3> out(T, Points3(static_cast<long>(N), 3));
-  for (uint64_t t = 0; t < T; ++t)
+  std::vector<Points3> out;
+  out.reserve(T);
+  for (uint64_t t = 0; t < T; ++t) {
+    out.emplace_back(static_cast<long>(N), 3);
     for (uint64_t i = 0; i < N * 3; ++i) out[t].data()[i] = p[t * N * 3 + i];
+  }
   return out;
 }
 
@@ -337,9 +384,15 @@ void validate_dataset(const Dataset& d, const std::string& where) {
 DatasetManifest read_manifest(const std::string& path) {
   std::ifstream in(path);
   if (!in || fs::is_directory(path)) fail_to_open(path);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_manifest(ss.str(), path);
+}
+
+DatasetManifest parse_manifest(const std::string& text, const std::string& path) {
   nlohmann::json j;
   try {
-    in >> j;
+    j = nlohmann::json::parse(text);
   } catch (const std::exception& e) {
     gdsr::fail("dataset", std::string(path) + ": invalid JSON");
   }
@@ -371,6 +424,7 @@ DatasetManifest read_manifest(const std::string& path) {
   }
   if (m.frames < 0 || m.lr_vertices < 0 || m.hr_vertices < 0 || m.body_vertices < 0)
     gdsr::fail("dataset", path + ": negative count");
+  if (!(m.fps > 0 && m.fps <= 1e4)) gdsr::fail("dataset", path + ": fps must be in (0, 10000]");
   return m;
 }
 
@@ -433,10 +487,20 @@ void write_dataset(const std::string& dir, const Dataset& d) {
   const std::string name = final_dir.filename().string();
   const fs::path tmp = final_dir.parent_path() / (name + ".tmp." + pid_suffix());
   std::error_code ec;
+  remove_stale_temps(final_dir.parent_path().string(), {name});  // from killed writes
   fs::remove_all(tmp, ec);
   fs::create_directories(tmp, ec);
   if (ec) gdsr::fail("dataset", "cannot create " + tmp.string() + ": " + ec.message());
   const std::string t = tmp.string();
+  // A failed write (full disk, ...) takes its temp folder with it.
+  struct RemoveOnFailure {
+    const fs::path& dir;
+    bool done = false;
+    ~RemoveOnFailure() {
+      std::error_code e;
+      if (!done) fs::remove_all(dir, e);
+    }
+  } cleanup{tmp};
 
   write_file_atomic(join(t, "manifest.json"), manifest_json(d.manifest, d.raster).dump(2) + "\n");
   write_obj(join(t, "lr.obj"), d.lr);
@@ -482,6 +546,7 @@ void write_dataset(const std::string& dir, const Dataset& d) {
     if (had) fs::rename(old, final_dir, ec);  // put the old dataset back
     gdsr::fail("dataset", "cannot rename " + tmp.string() + " to " + final_dir.string() + ": " + why);
   }
+  cleanup.done = true;
   if (had) fs::remove_all(old, ec);
 }
 
@@ -514,12 +579,11 @@ Dataset load_dataset(const std::string& dir, const LoadOptions& opt) {
   read_layer(d.hr, "hr_layer.bin");
 
   if (opt.frames) {
-    d.lr_frames = array_to_frames(read_array(join(dir, "lr_frames.bin"), v), join(dir, "lr_frames.bin"));
-    d.hr_frames = array_to_frames(read_array(join(dir, "hr_frames.bin"), v), join(dir, "hr_frames.bin"));
+    d.lr_frames = read_frames(join(dir, "lr_frames.bin"), v);
+    d.hr_frames = read_frames(join(dir, "hr_frames.bin"), v);
   }
   if (m.body_vertices > 0) {
-    if (opt.frames)
-      d.body_frames = array_to_frames(read_array(join(dir, "body_frames.bin"), v), join(dir, "body_frames.bin"));
+    if (opt.frames) d.body_frames = read_frames(join(dir, "body_frames.bin"), v);
     const Array bf = read_array(join(dir, "body_faces.bin"), v);
     expect_shape(bf, DType::i32, {static_cast<uint64_t>(m.body_faces), 3}, join(dir, "body_faces.bin"));
     d.body_faces = array_faces(bf);
@@ -531,11 +595,13 @@ Dataset load_dataset(const std::string& dir, const LoadOptions& opt) {
   c.lr_uv_to_vertex = d.lr.uv_to_vertex;
   c.lr_vertices = static_cast<int>(d.lr.V.rows());
   c.hr_vertices = static_cast<int>(d.hr.V.rows());
-  c.hr_from_lr = read_bary(dir, "corr_hr_from_lr", c.hr_vertices, v);
-  c.lr_from_hr = read_bary(dir, "corr_lr_from_hr", static_cast<int>(d.lr.UV.rows()), v);
+  c.hr_from_lr = read_bary(dir, "corr_hr_from_lr", c.hr_vertices, static_cast<int>(c.lr_F.rows()), v);
+  c.lr_from_hr =
+      read_bary(dir, "corr_lr_from_hr", static_cast<int>(d.lr.UV.rows()), static_cast<int>(c.hr_F.rows()), v);
   const Array nl = read_array(join(dir, "corr_hr_nearest_lr.bin"), v);
   expect_shape(nl, DType::i32, {static_cast<uint64_t>(c.hr_vertices)}, join(dir, "corr_hr_nearest_lr.bin"));
   c.hr_nearest_lr = to_ints(nl);
+  check_index_range(c.hr_nearest_lr, 0, c.lr_vertices, join(dir, "corr_hr_nearest_lr.bin"), "LR vertex");
 
   nlohmann::json j;
   std::ifstream(mpath) >> j;
@@ -549,10 +615,14 @@ Dataset load_dataset(const std::string& dir, const LoadOptions& opt) {
   expect_shape(rt, DType::i32, {static_cast<uint64_t>(r.height), static_cast<uint64_t>(r.width)},
                join(dir, "uv_raster_tri.bin"));
   r.tri = to_ints(rt);
+  check_index_range(r.tri, -1, static_cast<int>(d.hr.F.rows()), join(dir, "uv_raster_tri.bin"), "HR triangle");
   const Array rb = read_array(join(dir, "uv_raster_bary.bin"), v);
   expect_shape(rb, DType::f32, {static_cast<uint64_t>(r.height), static_cast<uint64_t>(r.width), 3},
                join(dir, "uv_raster_bary.bin"));
   r.bary.assign(data_of<float>(rb), data_of<float>(rb) + rb.count());
+  for (size_t px = 0; px < r.tri.size(); ++px)  // float32: the weights sum to 1 within rounding
+    if (r.tri[px] >= 0)
+      check_bary_row(r.bary[3 * px], r.bary[3 * px + 1], r.bary[3 * px + 2], 1e-4, join(dir, "uv_raster_bary.bin"), px);
 
   validate_dataset(d, dir);
   return d;

@@ -79,6 +79,8 @@ struct LoadOptions {
 };
 Dataset load_dataset(const std::string& dir, const LoadOptions& opt = {});
 DatasetManifest read_manifest(const std::string& path);
+// The same on the file's text; `path` names the file in errors.
+DatasetManifest parse_manifest(const std::string& text, const std::string& path);
 
 // ---- binary arrays (".bin"): see docs/dataset-format.md ----
 enum class DType : uint32_t { f32 = 1, i32 = 2, f64 = 3 };
@@ -91,6 +93,8 @@ struct Array {
 uint64_t fnv1a64(const char* data, size_t n);
 void write_array(const std::string& path, const Array& a);
 Array read_array(const std::string& path, bool verify_checksum = true);
+// The same on the file's bytes; `path` names the file in errors.
+Array parse_array(const std::string& bytes, const std::string& path, bool verify_checksum = true);
 
 // T frames of N x 3 positions <-> a float32 T x N x 3 array. Throws on ragged frames.
 Array frames_to_array(const std::vector<Points3>& frames);

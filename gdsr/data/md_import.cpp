@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -31,8 +33,6 @@ long last_number(const std::string& name) {
   }
   return value;
 }
-
-size_t count_objs(const std::string& dir) { return list_frame_objs(dir).size(); }
 
 // Applies a weld map to a sequence: faces re-indexed (first frame), positions compacted.
 void weld_sequence(std::vector<ObjData>& seq, const std::vector<int>& map, int count, const std::string& what) {
@@ -106,6 +106,25 @@ std::vector<ObjData> read_frame_sequence(const std::vector<std::string>& paths, 
   return out;
 }
 
+namespace {
+
+// Frames are stored as float32: a coordinate beyond its range (after `scale`) would become
+// inf in the dataset, so it is refused here, naming the file.
+void check_float_range(const std::vector<ObjData>& frames, const std::vector<std::string>& paths, double scale) {
+  for (size_t t = 0; t < frames.size(); ++t) {
+    // (NaN and inf never get here: the OBJ reader refuses them.)
+    const double m = frames[t].V.size() ? frames[t].V.cwiseAbs().maxCoeff() * scale : 0.0;
+    if (!(m <= std::numeric_limits<float>::max())) {
+      char v[32];
+      std::snprintf(v, sizeof v, "%.3g", m);
+      gdsr::fail(paths[t], std::string("coordinate of magnitude ") + v +
+                               " (after --scale) is beyond the float32 range of a dataset (3.4e38)");
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<int> weld_map(const Points3& V, double eps, int& count) {
   if (!(eps > 0)) gdsr::fail("import-md", "weld distance must be positive");
   auto key = [&](long x, long y, long z) { return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791); };
@@ -146,8 +165,7 @@ GarmentMesh garment_from_flat(const ObjData& flat, const ObjData& frame, const s
   int drop = 0;
   ext.minCoeff(&drop);
   const int a = drop == 0 ? 1 : 0, b = drop == 2 ? 1 : 2;
-  if (ext(drop) > 1e-3 * ext.maxCoeff())
-    gdsr::fail(what, "the flattened OBJ is not planar");
+  if (ext(drop) > 1e-3 * ext.maxCoeff()) gdsr::fail(what, "the flattened OBJ is not planar");
   ObjData merged;
   merged.V = frame.V;
   merged.F = frame.F;
@@ -161,20 +179,26 @@ GarmentMesh garment_from_flat(const ObjData& flat, const ObjData& frame, const s
 Dataset import_md(const MdImportOptions& opt) {
   if (!(opt.scale > 0)) gdsr::fail("import-md", "scale must be positive");
   if (!(opt.fps > 0)) gdsr::fail("import-md", "fps must be positive");
-  const size_t n_lr = count_objs(opt.lr_dir), n_hr = count_objs(opt.hr_dir);
-  const size_t n_body = opt.body_dir.empty() ? n_lr : count_objs(opt.body_dir);
+  // Each folder's numbering first (a gap, a repeat or an unnumbered file names the file),
+  // then the counts against each other.
+  const std::vector<std::string> lr_paths = list_frame_sequence(opt.lr_dir), hr_paths = list_frame_sequence(opt.hr_dir);
+  const std::vector<std::string> body_paths = opt.body_dir.empty() ? lr_paths : list_frame_sequence(opt.body_dir);
+  const size_t n_lr = lr_paths.size(), n_hr = hr_paths.size(), n_body = body_paths.size();
   if (n_lr != n_hr || n_lr != n_body)
-    gdsr::fail("import-md",
-               "mismatched frame counts: " + std::to_string(n_lr) + " LR, " + std::to_string(n_hr) + " HR" +
-                   (opt.body_dir.empty() ? std::string() : ", " + std::to_string(n_body) + " body") + " OBJ files");
+    gdsr::fail(
+        "import-md",
+        "mismatched frame counts: " + std::to_string(n_lr) + " LR (" + opt.lr_dir + "), " + std::to_string(n_hr) +
+            " HR (" + opt.hr_dir + ")" +
+            (opt.body_dir.empty() ? std::string() : ", " + std::to_string(n_body) + " body (" + opt.body_dir + ")") +
+            " OBJ files");
   const int total = static_cast<int>(n_lr + n_hr + (opt.body_dir.empty() ? 0 : n_body));
   int done = 0;
 
   Dataset d;
-  std::vector<ObjData> lr =
-      read_frame_sequence(list_frame_objs(opt.lr_dir), "import-md", "LR", done, total, opt.progress);
-  std::vector<ObjData> hr =
-      read_frame_sequence(list_frame_objs(opt.hr_dir), "import-md", "HR", done, total, opt.progress);
+  std::vector<ObjData> lr = read_frame_sequence(lr_paths, "import-md", "LR", done, total, opt.progress);
+  std::vector<ObjData> hr = read_frame_sequence(hr_paths, "import-md", "HR", done, total, opt.progress);
+  check_float_range(lr, lr_paths, opt.scale);
+  check_float_range(hr, hr_paths, opt.scale);
   if (opt.weld > 0) {
     int n = 0;
     const std::vector<int> lm = weld_map(lr[0].V * opt.scale, opt.weld, n);
@@ -195,8 +219,8 @@ Dataset import_md(const MdImportOptions& opt) {
   lr.clear();
   hr.clear();
   if (!opt.body_dir.empty()) {
-    std::vector<ObjData> body =
-        read_frame_sequence(list_frame_objs(opt.body_dir), "import-md", "body", done, total, opt.progress);
+    std::vector<ObjData> body = read_frame_sequence(body_paths, "import-md", "body", done, total, opt.progress);
+    check_float_range(body, body_paths, opt.scale);
     d.body_faces = body[0].F;
     for (auto& f : body) d.body_frames.push_back(f.V * opt.scale);
   }

@@ -8,9 +8,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <signal.h>
 #include <unistd.h>
 #include <vector>
 
@@ -98,8 +100,9 @@ std::string fmt(double x) {
 
 }  // namespace
 
-ObjData read_obj(const std::string& path) {
-  const std::string text = read_all(path);
+ObjData read_obj(const std::string& path) { return parse_obj(read_all(path), path); }
+
+ObjData parse_obj(const std::string& text, const std::string& path) {
   std::vector<double> v, vt;
   std::vector<int> f, ft;
   std::vector<long> cv, ct;
@@ -197,6 +200,27 @@ void write_file_atomic(const std::string& path, const std::string& bytes) {
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());
     gdsr::fail("write", "cannot rename " + tmp + " to " + path);
+  }
+}
+
+void remove_stale_temps(const std::string& dir, const std::vector<std::string>& names) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string n = e.path().filename().string();
+    for (const std::string& name : names) {
+      const std::string prefix = name + ".tmp.";
+      if (n.size() <= prefix.size() || n.compare(0, prefix.size(), prefix) != 0) continue;
+      const std::string pid = n.substr(prefix.size());
+      if (pid.size() > 9 || pid.find_first_not_of("0123456789") != std::string::npos) continue;
+      if (::kill(static_cast<pid_t>(std::stol(pid)), 0) == 0 || errno != ESRCH) continue;  // still running
+      if (e.is_directory(ec)) {
+        bool only_files = true;
+        for (const auto& f : fs::directory_iterator(e.path(), ec)) only_files = only_files && !f.is_directory(ec);
+        if (!only_files) continue;
+      }
+      fs::remove_all(e.path(), ec);
+    }
   }
 }
 

@@ -7,6 +7,7 @@
 #include "gdsr/geometry/mesh.hpp"
 
 #include <string>
+#include <vector>
 
 namespace gdsr {
 
@@ -22,6 +23,8 @@ struct ObjData {
 // Reads every v/vt/f line. Throws on a malformed number, an index out of range, a NaN or
 // infinite coordinate, or a file without vertices or faces.
 ObjData read_obj(const std::string& path);
+// The same on the file's bytes; `path` names the file in errors.
+ObjData parse_obj(const std::string& text, const std::string& path);
 
 // Positions and faces only.
 TriMesh read_obj_mesh(const std::string& path);
@@ -40,5 +43,10 @@ void write_obj(const std::string& path, const GarmentMesh& mesh);  // v, vt, f v
 
 // Writes `bytes` to `path` via path + ".tmp.<pid>" and a rename. Throws on any I/O error.
 void write_file_atomic(const std::string& path, const std::string& bytes);
+
+// Removes what killed writers left in `dir`: entries "<name>.tmp.<pid>" (files, or folders
+// holding only files) for each name in `names`, whose process <pid> no longer runs. A temp
+// of a running process is left alone. Best effort: errors are ignored.
+void remove_stale_temps(const std::string& dir, const std::vector<std::string>& names);
 
 }  // namespace gdsr

@@ -18,14 +18,18 @@ std::string checkpoint_metadata(const ModelConfig& cfg) {
 }
 
 ModelConfig config_from_checkpoint(const std::string& path) {
-  const nn::Checkpoint ck = nn::read_checkpoint(path);
+  return config_from_checkpoint(nn::read_checkpoint(path), path);
+}
+
+ModelConfig config_from_checkpoint(const nn::Checkpoint& ck, const std::string& path) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(ck.metadata);
   } catch (const std::exception&) {
     gdsr::fail(path, "checkpoint metadata is not JSON");
   }
-  if (!j.contains("model_config")) gdsr::fail(path, "not a GDSR model checkpoint (no model_config)");
+  if (!j.is_object() || !j.contains("model_config") || !j["model_config"].is_string())
+    gdsr::fail(path, "not a GDSR model checkpoint (no model_config)");
   return model_config_from_json_text(j["model_config"].get<std::string>(), path);
 }
 

@@ -1,8 +1,10 @@
 #include "gdsr/model/model_config.hpp"
 
 #include "gdsr/model/features.hpp"
+#include "gdsr/model/json_value.hpp"
 
 #include "gdsr/error.hpp"
+#include "gdsr/geometry/obj_io.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -111,7 +113,7 @@ ModelConfig model_config_from_json_text(const std::string& text, const std::stri
 #define X(name)                                  \
   if (key == #name) {                            \
     known = true;                                \
-    c.name = it.value().get<decltype(c.name)>(); \
+    c.name = json_value<decltype(c.name)>(it.value()); \
   }
       GDSR_CONFIG_FIELDS(X)
 #undef X
@@ -146,14 +148,7 @@ std::string model_config_to_json_text(const ModelConfig& c) {
 }
 
 void save_model_config(const ModelConfig& c, const std::string& path) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) gdsr::fail("model_config", "cannot write " + tmp);
-    out << model_config_to_json_text(c);
-    if (!out) gdsr::fail("model_config", "write failed for " + tmp);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) gdsr::fail("model_config", "cannot rename " + tmp + " to " + path);
+  write_file_atomic(path, model_config_to_json_text(c));
 }
 
 }  // namespace gdsr

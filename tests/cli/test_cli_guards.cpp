@@ -2,6 +2,7 @@
 // folders, bad numbers, mismatched predictions and bad files with one line, before any work,
 // and leaves what was there untouched.
 #include "gdsr/geometry/obj_io.hpp"
+#include "tests/support/cli_fixtures.hpp"
 #include "tests/support/cli_run.hpp"
 #include "tests/support/data_fixtures.hpp"
 
@@ -15,64 +16,16 @@
 #include <unistd.h>
 
 using gdsr_test::check_one_line_error;
+using gdsr_test::count_prefixed;
 using gdsr_test::gdsr_run;
+using gdsr_test::import_to;
+using gdsr_test::make_to;
 using gdsr_test::Run;
 using gdsr_test::slurp;
 using gdsr_test::TempDir;
+using gdsr_test::write_exports;
+using gdsr_test::write_pred;
 namespace fs = std::filesystem;
-
-namespace {
-
-// Names in `dir` that start with `prefix` (leftover temp / old folders).
-int count_prefixed(const std::string& dir, const std::string& prefix) {
-  int n = 0;
-  for (const auto& e : fs::directory_iterator(dir)) n += e.path().filename().string().rfind(prefix, 0) == 0;
-  return n;
-}
-
-// MD-style exports of the waving sheet: dir/lr, dir/hr frame folders and flattened OBJs.
-void write_exports(const TempDir& dir, int frames) {
-  const gdsr::Dataset d = gdsr_test::wave_dataset(frames);
-  fs::create_directories(dir / "lr");
-  fs::create_directories(dir / "hr");
-  gdsr::write_obj(dir / "lr_flat.obj", gdsr_test::flat_uv_mesh(d.lr));
-  gdsr::write_obj(dir / "hr_flat.obj", gdsr_test::flat_uv_mesh(d.hr));
-  for (int t = 0; t < frames; ++t) {
-    gdsr::write_obj(dir / ("lr/f" + std::to_string(t) + ".obj"), gdsr::TriMesh{d.lr_frames[t], d.lr.F});
-    gdsr::write_obj(dir / ("hr/f" + std::to_string(t) + ".obj"), gdsr::TriMesh{d.hr_frames[t], d.hr.F});
-  }
-}
-
-std::string import_to(const TempDir& dir, const std::string& out) {
-  return "data import-md --lr-dir '" + (dir / "lr") + "' --hr-dir '" + (dir / "hr") + "' --lr-uv '" +
-         (dir / "lr_flat.obj") + "' --hr-uv '" + (dir / "hr_flat.obj") + "' --out '" + out + "'";
-}
-
-std::string make_to(const std::string& out) {
-  return "data make --garment skirt_short --seconds 0.1 --lr-pd 0.08 --hr-pd 0.06 --rest-blend 2 --raster 64 --out '" +
-         out + "'";
-}
-
-// A prediction folder of frames [first, first + G.size()) recorded as made on `dataset`.
-void write_pred(const std::string& dir, const std::vector<gdsr::Points3>& G, int first, const std::string& dataset,
-                long long frames) {
-  fs::create_directories(dir);
-  gdsr::Array a;
-  a.dtype = gdsr::DType::f32;
-  const uint64_t n = G.empty() ? 81 : static_cast<uint64_t>(G[0].rows());
-  a.dims = {static_cast<uint64_t>(G.size()), n, 3};
-  for (const auto& g : G)
-    for (int i = 0; i < g.rows(); ++i)
-      for (int c = 0; c < 3; ++c) {
-        const float v = static_cast<float>(g(i, c));
-        a.bytes.append(reinterpret_cast<const char*>(&v), sizeof v);
-      }
-  gdsr::write_array(dir + "/pred_hr.bin", a);
-  gdsr::write_file_atomic(dir + "/prediction.json",
-                          nlohmann::json{{"first_frame", first}, {"frames", frames}, {"dataset", dataset}}.dump());
-}
-
-}  // namespace
 
 TEST_CASE("cli guards: --out refuses a folder that is not a dataset and a regular file") {
   TempDir dir("guard_out");
@@ -144,12 +97,12 @@ TEST_CASE("cli guards: infer and eval refuse --frames 0 and a folder as --model"
   gdsr::write_dataset(dir / "ds", gdsr_test::wave_dataset(4));
   for (const char* cmd : {"infer", "eval"})
     for (const char* bad : {"--frames 0", "--frames -5", "--first -1"}) {
-      const Run r = gdsr_run(dir, std::string(cmd) + " --model '" + (dir / "ds") + "' --data '" + (dir / "ds") +
-                                      "' " + bad);
+      const Run r =
+          gdsr_run(dir, std::string(cmd) + " --model '" + (dir / "ds") + "' --data '" + (dir / "ds") + "' " + bad);
       check_one_line_error(r, std::string(bad).substr(0, std::string(bad).find(' ')));
     }
-  const Run r = gdsr_run(dir, "infer --model '" + (dir / "ds") + "' --data '" + (dir / "ds") + "' --out '" +
-                                  (dir / "o") + "'");
+  const Run r =
+      gdsr_run(dir, "infer --model '" + (dir / "ds") + "' --data '" + (dir / "ds") + "' --out '" + (dir / "o") + "'");
   check_one_line_error(r, "is a folder");
   CHECK(r.err.find("bad_alloc") == std::string::npos);
   CHECK_FALSE(fs::exists(dir / "o"));

@@ -73,8 +73,8 @@ TEST_CASE("cli train: kill -9 mid-run then --resume is bit-identical to an unint
 
   // The same run in the background, killed with SIGKILL once it has checkpointed a few steps.
   const std::string killed = dir / "killed";
-  const std::string cmd = std::string("exec '") + GDSR_BINARY_DIR + "/gdsr' " + train_args(data, killed) +
-                          " >'" + (dir / "k.out") + "' 2>'" + (dir / "k.err") + "'";
+  const std::string cmd = std::string("exec '") + GDSR_BINARY_DIR + "/gdsr' " + train_args(data, killed) + " >'" +
+                          (dir / "k.out") + "' 2>'" + (dir / "k.err") + "'";
   const pid_t pid = fork();
   REQUIRE(pid >= 0);
   if (pid == 0) {
@@ -148,6 +148,18 @@ TEST_CASE("cli train: the run folder holds the CSV log and loss curves and confi
   CHECK(cfg.at("command").at("val_data").size() == 1);
   fs::copy_file(out + "/loss_curves.png", fs::path(GDSR_BINARY_DIR) / "cli_train_loss_curves.png",
                 fs::copy_options::overwrite_existing);  // kept to look at
+
+  // A log row edited by hand (a step that is not a number) is dropped on --resume, not a crash.
+  std::string log = slurp(out + "/train_log.csv");
+  log.replace(log.find('\n') + 1, 1, "x");
+  std::ofstream(out + "/train_log.csv", std::ios::trunc) << log;
+  const Run resumed =
+      gdsr_run(dir, "train --data '" + data + "' --val-data '" + data + "' --config '" + GDSR_SOURCE_DIR +
+                        "/configs/tiny.json' --no-vgg --patches 2 --patch-size 32 --epochs 5 " +
+                        "--frames-per-step 2 --resume '" + out + "/model.ckpt' --out '" + out + "'");
+  CHECK(resumed.status == 0);
+  CHECK(resumed.err.find("stoll") == std::string::npos);
+  CHECK(csv_rows(out + "/train_log.csv").size() == 14);  // 11 kept, 3 new
 }
 
 TEST_CASE("cli train: bad flags and files give a one-line error and write nothing") {
