@@ -131,7 +131,6 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     // Where each vertex was dressed: its closest body point in the first pose (within 0.3 m).
     if (!(p.pinch_separation > 0)) gdsr::fail("sim/cloth_solver", "pinch_separation must be positive");
     body_rest_ = body_V0;
-    outside_.assign(nv, {});
     home_ = Points3::Constant(nv, 3, std::numeric_limits<double>::quiet_NaN());
     SurfaceGrid wide;
     wide.build(bodyF_, body_V0, body_V0, 0.15);
@@ -200,33 +199,17 @@ void ClothSolver::place_pins(const Points3& body) {
   for (const auto& pin : pins_) x_.row(pin.v) = pin_position(pin, body).transpose();
 }
 
-void ClothSolver::add_contact(int v, const SurfaceHit& hit, const Vec3& rest, bool friction) {
-  // The side of a body part is the one the vertex was on at the last refresh where it was
-  // outside that part: a vertex found inside (a fast limb came through it between refreshes,
-  // or a pinch pressed it in) is pushed back out the way it came, not to the nearest side.
-  auto& slots = outside_[v];
-  const double sep2 = p_.pinch_separation * p_.pinch_separation;
-  int same = -1;
-  for (int k = 0; k < 2 && same < 0; ++k)
-    if (slots[k].face >= 0 && (slots[k].rest - rest).squaredNorm() <= sep2) same = k;
-  if (hit.signed_distance >= 0) {
-    slots[same >= 0 ? same : (slots[0].face < 0 ? 0 : 1)] = {hit.face, hit.bary, rest};
-    contacts_.push_back({v, hit.face, hit.bary, friction});
-  } else if (same >= 0) {
-    contacts_.push_back({v, slots[same].face, slots[same].bary, friction});
-  } else if (hit.signed_distance > -p_.max_push) {
-    // Inside with no history (the placement): deeper than max_push it went through a thin
-    // part, and pushing it out would tear the cloth, so leave it.
-    contacts_.push_back({v, hit.face, hit.bary, friction});
-  }
-}
-
 void ClothSolver::refresh_contacts(const Points3& body_now) {
   contacts_.clear();
   const int nv = static_cast<int>(x_.rows());
   if (bodyF_.rows() > 0) {
     const double r = p_.thickness + p_.contact_radius;
     const double sep2 = p_.pinch_separation * p_.pinch_separation;
+    auto add = [&](int v, const SurfaceHit& hit) {
+      // Deeper than max_push: the vertex went through a thin part; pushing it out would tear
+      // the cloth, so leave it.
+      if (hit.signed_distance > -p_.max_push) contacts_.push_back({v, hit.face, hit.bary});
+    };
     for (int v = 0; v < nv; ++v) {
       if (winv_[v] == 0) continue;
       const Vec3 x = x_.row(v).transpose();
@@ -235,8 +218,6 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
       // A second body part within reach (far from the first one in the first pose): the cloth
       // may be pinched between them (a hand pressing a skirt onto the hip). Both contacts
       // apply; the part the vertex was dressed on comes last, so it wins when they conflict.
-      // The other part has no friction: near an overlap its push-out is not a bounded normal
-      // force, and friction from it would drag the cloth along with a hand.
       const Vec3 ra = bary_point(body_rest_, bodyF_, a.face, a.bary);
       const SurfaceHit b = grid_.closest(x, body_now, r, [&](int f) {
         for (int k = 0; k < 3; ++k)
@@ -244,18 +225,14 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
         return true;
       });
       if (b.face < 0 || !home_.row(v).allFinite()) {
-        add_contact(v, a, ra, true);
+        add(v, a);
         continue;
       }
       const Vec3 home = home_.row(v).transpose();
       const Vec3 rb = bary_point(body_rest_, bodyF_, b.face, b.bary);
       const bool a_home = (ra - home).squaredNorm() <= (rb - home).squaredNorm();
-      const SurfaceHit& h = a_home ? a : b;
-      const SurfaceHit& o = a_home ? b : a;
-      // No room for the cloth between the parts (they overlap, as skinned hands and hips do):
-      // the other part passes through it; pushing would plough the cloth along with it.
-      if ((o.point - h.point).dot(h.normal) > 2 * p_.thickness) add_contact(v, o, a_home ? rb : ra, false);
-      add_contact(v, h, a_home ? ra : rb, true);
+      add(v, a_home ? b : a);
+      add(v, a_home ? a : b);
     }
   }
   layer_pairs_.clear();
@@ -397,14 +374,13 @@ void ClothSolver::solve_body_contacts(const Points3& body_prev, const Points3& b
     const double C = (x - q).dot(nrm) - p_.thickness;
     if (C >= 0) continue;
     x -= C * nrm;
-    if (c.friction) {  // Coulomb friction on the displacement relative to the body point this substep
-      const Vec3 qprev = bary_point(body_prev, bodyF_, c.face, c.bary);
-      Vec3 rel = (x - xprev_.row(c.v).transpose()) - (q - qprev);
-      rel -= rel.dot(nrm) * nrm;
-      const double rl = rel.norm();
-      const double lim = p_.friction * (-C);
-      if (rl > 0) x -= (rl <= lim ? 1.0 : lim / rl) * rel;
-    }
+    // Coulomb friction on the displacement relative to the body point this substep.
+    const Vec3 qprev = bary_point(body_prev, bodyF_, c.face, c.bary);
+    Vec3 rel = (x - xprev_.row(c.v).transpose()) - (q - qprev);
+    rel -= rel.dot(nrm) * nrm;
+    const double rl = rel.norm();
+    const double lim = p_.friction * (-C);
+    if (rl > 0) x -= (rl <= lim ? 1.0 : lim / rl) * rel;
     x_.row(c.v) = x.transpose();
   }
 }

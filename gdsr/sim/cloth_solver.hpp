@@ -23,7 +23,6 @@
 #include "gdsr/sim/cloth_tethers.hpp"
 #include "gdsr/sim/garments.hpp"
 
-#include <array>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -105,12 +104,6 @@ class ClothSolver {
   struct Contact {
     int v, face;
     gdsr::Vec3 bary;
-    bool friction = true;  // false for the second part of a pinch (see refresh_contacts)
-  };
-  struct Outside {  // a body contact the vertex was outside of at a refresh
-    int face = -1;
-    gdsr::Vec3 bary = gdsr::Vec3::Zero();
-    gdsr::Vec3 rest = gdsr::Vec3::Zero();  // the contact point in the first pose (tells body parts apart)
   };
   struct LayerPair {
     int outer, inner;
@@ -118,7 +111,6 @@ class ClothSolver {
   };
 
   void refresh_contacts(const gdsr::Points3& body_now);
-  void add_contact(int v, const SurfaceHit& hit, const gdsr::Vec3& rest, bool friction);
   void place_pins(const gdsr::Points3& body);
   // The steps of one substep of length h (seconds), in the order step() runs them.
   void detect_self_contacts(double h);
@@ -147,7 +139,6 @@ class ClothSolver {
   std::vector<Contact> contacts_;
   gdsr::Points3 body_rest_;                // body vertices in the first pose (pinch_separation is measured there)
   gdsr::Points3 home_;                     // per cloth vertex: closest body point in the first pose (NaN: none)
-  std::vector<std::array<Outside, 2>> outside_;  // per cloth vertex: the last outside contact on up to 2 parts
   std::vector<LayerPair> layer_pairs_;
   SurfaceGrid grid_;
   double body_cell_ = 0.05;
