@@ -58,7 +58,7 @@ struct MakeArgs {
   double fps = 30;
   int substeps = -1;  // <0: the solver's default
   // Solver knobs (NaN / <0: the solver's default, sim::SimParams).
-  int iterations = -1, stretch_passes = -1, settle_frames = -1;
+  int iterations = -1, stretch_passes = -1, settle_frames = -1, contact_every = -1;
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN;
   bool self_collision = true;
   int rest_blend_frames = 15;
@@ -148,6 +148,7 @@ void run_make(const MakeArgs& a) {
   if (a.iterations > 0) params.iterations = a.iterations;
   if (a.stretch_passes > 0) params.stretch_passes = a.stretch_passes;
   if (a.settle_frames >= 0) params.settle_frames = a.settle_frames;
+  if (a.contact_every > 0) params.contact_every = a.contact_every;
   if (!std::isnan(a.friction)) params.friction = a.friction;
   if (!std::isnan(a.bend_stiffness)) params.bend_stiffness = a.bend_stiffness;
   if (!std::isnan(a.self_thickness)) params.self_thickness = a.self_thickness;
@@ -186,6 +187,7 @@ void run_make(const MakeArgs& a) {
                   {"bend_stiffness_n_m", params.bend_stiffness},
                   {"damping_1_s", params.damping},
                   {"settle_frames", params.settle_frames},
+                  {"contact_every", params.contact_every},
                   {"settle_damping_1_s", params.settle_damping},
                   {"self_collision", params.self_collision},
                   {"self_thickness_m", params.self_thickness},
@@ -442,6 +444,9 @@ void add_data_command(CLI::App& app) {
   make->add_option("--compression-ratio", mk->compression_ratio,
                    "in-plane compression stiffness / stretch stiffness (default: the solver's)")
       ->check(finite_range(1e-4, 1.0));
+  make->add_option("--contact-every", mk->contact_every,
+                   "substeps between body contact refreshes (default: the solver's)")
+      ->check(CLI::Range(1, 1000));
   make->add_option("--settle-frames", mk->settle_frames,
                    "frames of damped motion on the first pose before frame 0 (default: the solver's)")
       ->check(CLI::Range(0, 1000));
