@@ -218,13 +218,17 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
       // A second body part within reach (far from the first one in the first pose): the cloth
       // may be pinched between them (a hand pressing a skirt onto the hip). Both contacts
       // apply; the part the vertex was dressed on comes last, so it wins when they conflict.
+      if (!home_.row(v).allFinite()) {  // dressed nowhere near the body: nothing to prefer
+        add(v, a);
+        continue;
+      }
       const Vec3 ra = bary_point(body_rest_, bodyF_, a.face, a.bary);
       const SurfaceHit b = grid_.closest(x, body_now, r, [&](int f) {
         for (int k = 0; k < 3; ++k)
           if ((body_rest_.row(bodyF_(f, k)).transpose() - ra).squaredNorm() <= sep2) return false;
         return true;
       });
-      if (b.face < 0 || !home_.row(v).allFinite()) {
+      if (b.face < 0) {
         add(v, a);
         continue;
       }
