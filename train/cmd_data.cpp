@@ -58,8 +58,8 @@ struct MakeArgs {
   double fps = 30;
   int substeps = -1;  // <0: the solver's default
   // Solver knobs (NaN / <0: the solver's default, sim::SimParams).
-  int iterations = -1, stretch_passes = -1, settle_frames = -1, contact_every = -1;
-  double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN;
+  int iterations = -1, stretch_passes = -1, settle_frames = -1, contact_every = -1, self_detect_every = -1;
+  double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN, self_slack = NAN;
   bool self_collision = true;
   int rest_blend_frames = 15;
   int raster = 1024;
@@ -152,6 +152,8 @@ void run_make(const MakeArgs& a) {
   if (!std::isnan(a.friction)) params.friction = a.friction;
   if (!std::isnan(a.bend_stiffness)) params.bend_stiffness = a.bend_stiffness;
   if (!std::isnan(a.self_thickness)) params.self_thickness = a.self_thickness;
+  if (!std::isnan(a.self_slack)) params.self_slack = a.self_slack;
+  if (a.self_detect_every > 0) params.self_detect_every = a.self_detect_every;
   if (!std::isnan(a.compression_ratio)) params.compression_ratio = a.compression_ratio;
   params.self_collision = a.self_collision;
   const SimRun lr = simulate_one(a, a.lr_pd, "LR", body, params);
@@ -191,6 +193,8 @@ void run_make(const MakeArgs& a) {
                   {"settle_damping_1_s", params.settle_damping},
                   {"self_collision", params.self_collision},
                   {"self_thickness_m", params.self_thickness},
+                  {"self_slack_m", params.self_slack},
+                  {"self_detect_every", params.self_detect_every},
                   {"compression_ratio", params.compression_ratio},
                   {"clip_start_s", a.start},
                   {"clip_seconds", a.seconds}};
@@ -441,6 +445,13 @@ void add_data_command(CLI::App& app) {
       ->check(finite_range(0.0, 1.0));
   make->add_option("--self-thickness", mk->self_thickness, "cloth-cloth distance kept, metres (default: the solver's)")
       ->check(finite_range(0.0, 0.05));
+  make->add_option("--self-slack", mk->self_slack,
+                   "metres a vertex may leave its predicted path before self-contacts are re-detected"
+                   " (default: the solver's; smaller is faster on smooth cloth, re-detects more in fast folds)")
+      ->check(finite_range(1e-5, 0.05));
+  make->add_option("--self-detect-every", mk->self_detect_every,
+                   "substeps between self-contact detections (default: the solver's)")
+      ->check(CLI::Range(1, 1000));
   make->add_option("--compression-ratio", mk->compression_ratio,
                    "in-plane compression stiffness / stretch stiffness (default: the solver's)")
       ->check(finite_range(1e-4, 1.0));

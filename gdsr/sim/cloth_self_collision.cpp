@@ -4,6 +4,7 @@
 #include "gdsr/geometry/triangle.hpp"
 
 #include <embree3/rtcore.h>
+#include <omp.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -96,7 +97,7 @@ constexpr double kEdgeEnd = 1e-3;  // edge parameter tolerance for an interior e
 struct SelfCollision::Embree {
   RTCDevice device = nullptr;
   const Points3* x = nullptr;
-  const Points3* motion = nullptr;
+  const Points3* motion = nullptr;  // null: boxes of the current positions only
   double pad = 0;
   const SelfCollision* owner = nullptr;
   std::mutex mutex;
@@ -109,7 +110,7 @@ struct SelfCollision::Embree {
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
     for (int k = 0; k < n; ++k)
       for (int c = 0; c < 3; ++c) {
-        const double a = (*x)(ids[k], c), b = a + (*motion)(ids[k], c);
+        const double a = (*x)(ids[k], c), b = motion ? a + (*motion)(ids[k], c) : a;
         lo[c] = std::min(lo[c], std::min(a, b) - pad);
         hi[c] = std::max(hi[c], std::max(a, b) + pad);
       }
@@ -188,6 +189,16 @@ struct SelfCollision::Embree {
   }
 };
 
+namespace {
+struct ScenesGuard {  // releases the scenes of one broad phase, also when a collide throws
+  RTCScene s[3] = {nullptr, nullptr, nullptr};
+  ~ScenesGuard() {
+    for (RTCScene sc : s)
+      if (sc) rtcReleaseScene(sc);
+  }
+};
+}  // namespace
+
 SelfCollision::SelfCollision(const gdsr::Faces& F, int num_vertices) : F_(F), embree_(std::make_unique<Embree>()) {
   if (F.rows() > 0 && (F.minCoeff() < 0 || F.maxCoeff() >= num_vertices)) fail("faces index missing vertices");
   std::map<std::pair<int, int>, int> ids;
@@ -198,7 +209,9 @@ SelfCollision::SelfCollision(const gdsr::Faces& F, int num_vertices) : F_(F), em
       if (ids.emplace(key, static_cast<int>(edges_.size())).second) edges_.push_back({key.first, key.second});
     }
   tangled_.assign(num_vertices, 0);
-  embree_->device = rtcNewDevice("threads=1");
+  // As many broad-phase threads as the narrow phase's OpenMP threads (OMP_NUM_THREADS).
+  const std::string config = "threads=" + std::to_string(std::max(1, omp_get_max_threads()));
+  embree_->device = rtcNewDevice(config.c_str());
   if (!embree_->device) fail("cannot create an Embree device");
 }
 
@@ -228,35 +241,43 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
   E.motion = &motion;
   E.pad = 0.5 * thickness + slack;
   E.owner = this;
-  RTCScene sv = E.scene(nv, [](const RTCBoundsFunctionArguments* a) {
-    const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
-    const int v = static_cast<int>(a->primID);
-    e->bounds(&v, 1, a->bounds_o);
-  });
-  RTCScene se = E.scene(ne, [](const RTCBoundsFunctionArguments* a) {
-    const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
-    e->bounds(e->owner->edges_[a->primID].data(), 2, a->bounds_o);
-  });
-  RTCScene sf = E.scene(nf, [](const RTCBoundsFunctionArguments* a) {
-    const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
-    const int f = static_cast<int>(a->primID);
-    const int ids[3] = {e->owner->F_(f, 0), e->owner->F_(f, 1), e->owner->F_(f, 2)};
-    e->bounds(ids, 3, a->bounds_o);
-  });
+  auto edge_scene = [&] {
+    return E.scene(ne, [](const RTCBoundsFunctionArguments* a) {
+      const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
+      e->bounds(e->owner->edges_[a->primID].data(), 2, a->bounds_o);
+    });
+  };
+  auto face_scene = [&] {
+    return E.scene(nf, [](const RTCBoundsFunctionArguments* a) {
+      const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
+      const int f = static_cast<int>(a->primID);
+      const int ids[3] = {e->owner->F_(f, 0), e->owner->F_(f, 1), e->owner->F_(f, 2)};
+      e->bounds(ids, 3, a->bounds_o);
+    });
+  };
   std::vector<std::pair<int, int>> vf, ee, ef;
-  try {
-    vf = E.collide(sv, 0, sf, 2);
-    ee = E.collide(se, 1, se, 1);
-    if (tangle_test) ef = E.collide(se, 1, sf, 2);
-  } catch (...) {
-    rtcReleaseScene(sv);
-    rtcReleaseScene(se);
-    rtcReleaseScene(sf);
-    throw;
+  {
+    ScenesGuard g;
+    g.s[0] = E.scene(nv, [](const RTCBoundsFunctionArguments* a) {
+      const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
+      const int v = static_cast<int>(a->primID);
+      e->bounds(&v, 1, a->bounds_o);
+    });
+    g.s[1] = edge_scene();
+    g.s[2] = face_scene();
+    vf = E.collide(g.s[0], 0, g.s[2], 2);
+    ee = E.collide(g.s[1], 1, g.s[1], 1);
   }
-  rtcReleaseScene(sv);
-  rtcReleaseScene(se);
-  rtcReleaseScene(sf);
+  if (tangle_test) {
+    // An edge crossing a face now: tight boxes of the current positions (the swept, padded
+    // boxes above would pass several times more candidates for the same exact test).
+    E.motion = nullptr;
+    E.pad = 0;
+    ScenesGuard g;
+    g.s[1] = edge_scene();
+    g.s[2] = face_scene();
+    ef = E.collide(g.s[1], 1, g.s[2], 2);
+  }
 
   // Narrow phase (parallel; every candidate writes its own slot, so the result does not
   // depend on the thread count).

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -205,11 +206,16 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
   if (bodyF_.rows() > 0) {
     const double r = p_.thickness + p_.contact_radius;
     const double sep2 = p_.pinch_separation * p_.pinch_separation;
+    // Up to two contacts per vertex, found in parallel (each vertex fills its own slots),
+    // then gathered in vertex order, so the result does not depend on the thread count.
+    std::vector<std::array<Contact, 2>> found(nv);
+    std::vector<signed char> count(nv, 0);
     auto add = [&](int v, const SurfaceHit& hit) {
       // Deeper than max_push: the vertex went through a thin part; pushing it out would tear
       // the cloth, so leave it.
-      if (hit.signed_distance > -p_.max_push) contacts_.push_back({v, hit.face, hit.bary});
+      if (hit.signed_distance > -p_.max_push) found[v][count[v]++] = {v, hit.face, hit.bary};
     };
+#pragma omp parallel for schedule(dynamic, 256)
     for (int v = 0; v < nv; ++v) {
       if (winv_[v] == 0) continue;
       const Vec3 x = x_.row(v).transpose();
@@ -238,6 +244,8 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
       add(v, a_home ? b : a);
       add(v, a_home ? a : b);
     }
+    for (int v = 0; v < nv; ++v)
+      for (int k = 0; k < count[v]; ++k) contacts_.push_back(found[v][k]);
   }
   layer_pairs_.clear();
   if (layer_.empty()) return;
@@ -286,12 +294,16 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
 void ClothSolver::detect_self_contacts(double h) {
   // On the current (intersection-free) state, covering the motion of the next
   // self_detect_every substeps; sooner when a vertex left its slack (track_self_slack).
+  // The tangle test (edges crossing faces) runs at the first detection of each frame only:
+  // it is a third of a detection's cost, and an intersection that slipped through stays
+  // guarded for at most one frame before it is freed to untangle.
   if (!self_ || since_detect_ < p_.self_detect_every) return;
   const int nv = static_cast<int>(x_.rows());
   const double T = p_.self_detect_every * h;
   for (int v = 0; v < nv; ++v)
     motion_.row(v) = v_.row(v) * T + (winv_[v] == 0 ? 0.0 : 0.5 * T * T) * p_.gravity.transpose();
-  self_->detect(x_, motion_, p_.self_slack, p_.self_thickness);
+  self_->detect(x_, motion_, p_.self_slack, p_.self_thickness, tangle_test_due_);
+  tangle_test_due_ = false;
   x_detect_ = x_;
   since_detect_ = 0;
 }
@@ -426,6 +438,7 @@ void ClothSolver::step(const Points3& body_from, const Points3& body_to, double 
   Points3 body_prev = body_from, body_now = body_from;
   const double decay = std::exp(-p_.damping * h);
   std::vector<double> lambda_e(edges_.size()), lambda_b(bends_.size());
+  tangle_test_due_ = true;
 
   for (int s = 0; s < n; ++s) {
     // The body moves linearly from body_from to body_to over the frame.

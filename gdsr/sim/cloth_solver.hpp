@@ -149,6 +149,7 @@ class ClothSolver {
   gdsr::Points3 x_detect_;      // positions at the last self-contact detection
   gdsr::Points3 motion_;        // m, per vertex: predicted motion until the next detection
   int since_detect_ = 1 << 30;  // substeps since the last detection
+  bool tangle_test_due_ = true;  // the next detection also runs the tangle test (once per frame)
 };
 
 // Simulates the garment on body frames (each frames[t] is a pose of body_F, metres) at
