@@ -92,6 +92,12 @@ std::vector<Case> cases() {
 
 }  // namespace
 
+std::vector<std::string> gradcheck_suite_ops() {
+  std::vector<std::string> names;
+  for (const Case& c : cases()) names.push_back(c.op);
+  return names;
+}
+
 std::vector<NamedGradCheck> run_gradcheck_suite(unsigned seed, const std::function<void(int, int)>& progress) {
   std::mt19937_64 rng(seed);
   const std::vector<Case> all = cases();
