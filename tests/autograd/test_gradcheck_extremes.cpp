@@ -61,6 +61,7 @@ struct OpRows {
   Ref ref;
   DRef dref;  // needed by Grad::closed rows
   std::vector<Scale> scales;
+  ag::GradCheckOptions opt = {};
 };
 
 template <class V> using S = typename std::decay_t<V>::value_type::Scalar;
@@ -513,6 +514,106 @@ std::vector<OpRows> table() {
       },
       lin));
   t.push_back(op(
+      "square", [](const auto& x) { return ag::square(x[0]); }, scaled({u43}),
+      [](const std::vector<LIn>& a) { return map1(a[0], [](LD x) { return x * x; }); },
+      {{"mm", 1e-3, 1e-3}, {"km", 1e3, 1e3}, {"tiny", 1e-150, 1e-17}, {"huge", 1e150, 1e17}}));
+  // -2.5 x + 0.5: at tiny the offset 0.5 hides x (below its ulp), so L does not move under
+  // central differences; the value 0.5 holds to rounding and the gradient in closed form.
+  t.push_back(op(
+      "neg / mul_scalar / add_scalar",
+      [](const auto& x) {
+        using T = S<decltype(x)>;
+        return ag::add_scalar(ag::mul_scalar(ag::neg(x[0]), T(2.5)), T(0.5));
+      },
+      scaled({u43}), [](const std::vector<LIn>& a) { return map1(a[0], [](LD x) { return -2.5L * x + 0.5L; }); },
+      {{"mm", 1e-3, 1e-3}, {"km", 1e3, 1e3}, {"tiny", 1e-300, 1e-35, Grad::closed}, {"huge", 1e300, 1e35}},
+      [](const std::vector<LIn>& a) { return std::vector<std::vector<LD>>{map1(a[0], [](LD) { return -2.5L; })}; }));
+  t.push_back(op(
+      "sum / mean / mean_rows / sum_cols",
+      [](const auto& x) {
+        return ag::concat_cols<S<decltype(x)>>(
+            {ag::add(ag::sum_cols(x[0]), ag::mean(x[0])), ag::transpose(ag::add(ag::mean_rows(x[0]), ag::sum(x[0])))});
+      },
+      scaled({u43}),
+      [](const std::vector<LIn>& a) {
+        LD all = 0;
+        for (LD x : a[0].v) all += x;
+        std::vector<LD> o;
+        for (int64_t c = 0; c < 3; ++c)
+          o.push_back(a[0].at(0, c) + a[0].at(1, c) + a[0].at(2, c) + a[0].at(3, c) + all / 12);
+        for (int64_t r = 0; r < 4; ++r) o.push_back((a[0].at(r, 0) + a[0].at(r, 1) + a[0].at(r, 2)) / 3 + all);
+        return o;
+      },
+      lin));
+  t.push_back(op(
+      "concat_rows / slice_rows / reshape",
+      [](const auto& x) {
+        return ag::reshape(ag::slice_rows(ag::concat_rows<S<decltype(x)>>({x[0], x[1]}), 1, 5), {3, 4});
+      },
+      scaled({u43, randn({2, 3}, 134)}),
+      [](const std::vector<LIn>& a) {
+        std::vector<LD> o(a[0].v.begin() + 3, a[0].v.end());  // rows 1..3 of the first, row 0 of the second
+        o.insert(o.end(), a[1].v.begin(), a[1].v.begin() + 3);
+        return o;
+      },
+      lin));
+  t.push_back(op(
+      "linear_leaky_relu", [](const auto& x) { return ag::linear_leaky_relu(x[0], x[1], x[2], S<decltype(x)>(0.02)); },
+      scaled({u43, randn({5, 3}, 110), randn({1, 5}, 111)}, {1, 1, 2}),
+      [](const std::vector<LIn>& a) {
+        std::vector<LD> y = affine<LD>(
+            a[0].v, 4, 3, 5, [&](int64_t, int64_t o, int64_t i) { return a[1].at(o, i); },
+            [&](int64_t, int64_t o) { return a[2].at(0, o); });
+        for (LD& v : y) v = v > 0 ? v : LD(0.02) * v;
+        return y;
+      },
+      bil));
+  // Both operands scaled alike (as div): |w|^2 under- or overflows at tiny and huge unless
+  // the quotient is formed scaled.
+  t.push_back(op(
+      "complex div",
+      [](const auto& x) { return split_t(ag::div(ag::complex_from(x[0], x[1]), ag::complex_from(x[2], x[3]))); },
+      scaled({u43, v43, pos43, randu({4, 3}, 135, 0.5, 2)}),
+      [](const std::vector<LIn>& a) {
+        const std::vector<CLD> z = cplx_in(a[0], a[1]), w = cplx_in(a[2], a[3]);
+        std::vector<CLD> q;
+        for (size_t i = 0; i < z.size(); ++i) q.push_back(z[i] / w[i]);
+        return split_ref(q, 4, 3);
+      },
+      lin));
+  // Planes [2 x 10]: column 0 and 9 unused, 1..6 the 2x3 weights, 7..8 the bias (scaled s^2,
+  // as a bias added to x W).
+  const Tensord pre = randn({2, 10}, 136), pim = randn({2, 10}, 137);
+  auto planes = [u43, v43, pre, pim](double s) {
+    std::vector<Tensord> in = scaled({u43, v43})(s);
+    for (const Tensord& p : {pre, pim}) {
+      std::vector<double> v = p.values();
+      for (size_t k = 0; k < v.size(); ++k) v[k] *= (k % 10 == 7 || k % 10 == 8) ? s * s : s;
+      in.push_back(Tensord::from(p.shape(), v));
+    }
+    return in;
+  };
+  t.push_back(op(
+      "complex grouped_linear_planes",
+      [](const auto& x) {
+        return split_t(ag::grouped_linear_planes(ag::complex_from(x[0], x[1]), x[2], x[3], 1, 7, {0, 0, 1, 1}, 2));
+      },
+      planes,
+      [](const std::vector<LIn>& a) {
+        const std::vector<CLD> x = cplx_in(a[0], a[1]), p = cplx_in(a[2], a[3]);
+        auto g = [](int64_t r) { return r < 2 ? 0 : 1; };
+        return split_ref(
+            affine<CLD>(
+                x, 4, 3, 2,
+                [&](int64_t r, int64_t o, int64_t i) { return p[static_cast<size_t>(g(r) * 10 + 1 + o * 3 + i)]; },
+                [&](int64_t r, int64_t o) { return p[static_cast<size_t>(g(r) * 10 + 7 + o)]; }),
+            4, 2);
+      },
+      bil));
+  // The planes hold weights (~s) and biases (~s^2) side by side: each column is judged at its
+  // own scale (one step of 1e-6 s^2 would make a weight entry s^2 and overflow at huge).
+  t.back().opt.per_column = true;
+  t.push_back(op(
       "conv2d_3x3", [](const auto& x) { return ag::conv2d_3x3(x[0], x[1], x[2]); },
       scaled({randn({1, 2, 5, 4}, 130), randn({3, 2, 3, 3}, 131), randn({1, 3}, 132)}, {1, 1, 2}),
       [](const std::vector<LIn>& a) {
@@ -610,7 +711,7 @@ void run_row(const OpRows& o, const Scale& sc) {
     check_against(what + " (float32 value)", y.data(), o.ref(l32), 1e-5, sc.inf_ok);
   }
   if (sc.grad == Grad::central) {
-    ag::GradCheckOptions opt;
+    ag::GradCheckOptions opt = o.opt;
     if (sc.step > 0) opt.step = sc.step;
     const ag::GradCheckResult r = ag::gradcheck(o.f, in, opt);
     CHECK(r.checked > 0);
