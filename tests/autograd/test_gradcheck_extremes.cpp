@@ -7,7 +7,8 @@
 //    float32 scale where it has one);
 //  - the float64 gradient: central differences within the suite's 1e-6 (Grad::central), or,
 //    where central differences cannot be formed (the op's period is below the spacing of the
-//    doubles, or the value is inf), the analytic gradient against its closed form (Grad::closed).
+//    doubles, the value is inf, the inputs are subnormal, or an offset hides them), the
+//    analytic gradient against its closed form (Grad::closed).
 // Where the exact value or gradient lies beyond the largest float, the op must give inf of the
 // right sign, as its header documents (rows marked inf_ok, with the reason).
 // The coverage test fails if a suite op has no row here.
