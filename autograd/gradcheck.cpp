@@ -40,16 +40,20 @@ GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>
   for (double& v : w) v = (rng() & 1 ? 1.0 : -1.0) * uw(rng);
   const Tensord weights = Tensord::from(probe.shape(), w);
 
+  // L and |L| are summed in long double: outputs near the largest double (each finite) would
+  // otherwise sum to inf, making the difference quotient NaN and the floor below inf (which
+  // passes any gradient).
+  using Wide = long double;
   auto loss_value = [&]() {
     NoGradGuard ng;
     const Tensord y = f(inputs);
     if (y.numel() != static_cast<int64_t>(w.size())) throw Error("gradcheck: output size changed between calls");
-    double s = 0;
-    for (size_t i = 0; i < w.size(); ++i) s += w[i] * y.data()[i];
+    Wide s = 0;
+    for (size_t i = 0; i < w.size(); ++i) s += Wide(w[i]) * y.data()[i];
     return s;
   };
-  double loss_magnitude = 0;  // sum |w f|: the size round-off in L is relative to
-  for (size_t i = 0; i < w.size(); ++i) loss_magnitude += std::abs(w[i] * probe.data()[i]);
+  Wide loss_magnitude = 0;  // sum |w f|: the size round-off in L is relative to
+  for (size_t i = 0; i < w.size(); ++i) loss_magnitude += std::abs(Wide(w[i]) * probe.data()[i]);
 
   // Analytic gradients.
   {
@@ -88,16 +92,17 @@ GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>
         const double h = opt.step * scale;
         const double xp = orig + h, xm = orig - h;
         v = xp;
-        const double lp = loss_value();
+        const Wide lp = loss_value();
         v = xm;
-        const double lm = loss_value();
+        const Wide lm = loss_value();
         v = orig;
-        numeric[e] = (lp - lm) / (xp - xm);
+        numeric[e] = static_cast<double>((lp - lm) / (Wide(xp) - Wide(xm)));
       }
       double largest = 0;
       for (double v : numeric) largest = std::max(largest, std::abs(v));
-      const double floor = std::max({opt.floor_fraction * largest, opt.abs_floor, 1e-12 * loss_magnitude / scale,
-                                     std::numeric_limits<double>::min()});
+      const double floor =
+          std::max({opt.floor_fraction * largest, opt.abs_floor, static_cast<double>(1e-12L * loss_magnitude / scale),
+                    std::numeric_limits<double>::min()});
       for (size_t e = 0; e < group.size(); ++e) {
         const double a = analytic[static_cast<size_t>(group[e])], nu = numeric[e];
         double rel = std::abs(a - nu) / std::max({std::abs(a), std::abs(nu), floor});

@@ -45,7 +45,8 @@ struct GradCheckOptions {
 
 // f maps the inputs to a tensor; the check differentiates L = sum(w * f(inputs)) with fixed
 // random weights w. Analytic gradients come from backward(); numeric ones from central
-// differences of L. Inputs must be leaves; they are restored afterwards.
+// differences of L (L summed in long double, so outputs near the largest double do not
+// overflow it). Inputs must be leaves; they are restored afterwards.
 GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>&)>& f, std::vector<Tensord> inputs,
                           const GradCheckOptions& opt = {});
 

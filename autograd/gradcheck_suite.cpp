@@ -84,6 +84,32 @@ std::vector<Case> cases() {
                {{4, 3}, {4, 3}, {2, 6}, {2, 6}, {2, 2}, {2, 2}}});
   c.push_back(
       {"wire", [](V x) { return split(wire(complex_from(x[0], x[1]), 5.0, 10.0)); }, {{4, 3}, {4, 3}}, -0.15, 0.15});
+  c.push_back({"square", [](V x) { return square(x[0]); }, {{4, 3}}});
+  c.push_back(
+      {"neg / mul_scalar / add_scalar", [](V x) { return add_scalar(mul_scalar(neg(x[0]), 2.5), 0.5); }, {{4, 3}}});
+  c.push_back(
+      {"sum / mean / mean_rows / sum_cols",
+       [](V x) {
+         return concat_cols<double>({add(sum_cols(x[0]), mean(x[0])), transpose(add(mean_rows(x[0]), sum(x[0])))});
+       },
+       {{4, 3}}});
+  c.push_back({"concat_rows / slice_rows / reshape",
+               [](V x) {
+                 return reshape(slice_rows(concat_rows<double>({x[0], x[1]}), 1, 5), {3, 4});
+               },
+               {{4, 3}, {2, 3}}});
+  c.push_back(
+      {"linear_leaky_relu", [](V x) { return linear_leaky_relu(x[0], x[1], x[2], 0.02); }, {{4, 3}, {5, 3}, {1, 5}}});
+  c.push_back({"complex div",
+               [](V x) { return split(div(complex_from(x[0], x[1]), complex_from(x[2], x[3]))); },
+               {{4, 3}, {4, 3}, {4, 3}, {4, 3}},
+               0.5,
+               2});
+  c.push_back({"complex grouped_linear_planes",
+               [](V x) {
+                 return split(grouped_linear_planes(complex_from(x[0], x[1]), x[2], x[3], 1, 7, {0, 0, 1, 1}, 2));
+               },
+               {{4, 3}, {4, 3}, {2, 10}, {2, 10}}});
   c.push_back({"conv2d_3x3", [](V x) { return conv2d_3x3(x[0], x[1], x[2]); }, {{1, 2, 5, 4}, {3, 2, 3, 3}, {1, 3}}});
   c.push_back({"avg_pool2x2", [](V x) { return avg_pool2x2(x[0]); }, {{1, 2, 4, 6}}});
   c.push_back({"max_pool2x2", [](V x) { return max_pool2x2(x[0]); }, {{1, 2, 4, 6}}});
@@ -91,6 +117,12 @@ std::vector<Case> cases() {
 }
 
 }  // namespace
+
+std::vector<std::string> gradcheck_suite_ops() {
+  std::vector<std::string> names;
+  for (const Case& c : cases()) names.push_back(c.op);
+  return names;
+}
 
 std::vector<NamedGradCheck> run_gradcheck_suite(unsigned seed, const std::function<void(int, int)>& progress) {
   std::mt19937_64 rng(seed);

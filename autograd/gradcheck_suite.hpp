@@ -21,4 +21,8 @@ struct NamedGradCheck {
 // Runs all checks; `progress(done, total)` after each one (may be empty).
 std::vector<NamedGradCheck> run_gradcheck_suite(unsigned seed = 7, const std::function<void(int, int)>& progress = {});
 
+// The names of the ops the suite checks, in its order (the extreme-scale test in
+// tests/autograd/ requires a row for each, so no op joins the suite without one).
+std::vector<std::string> gradcheck_suite_ops();
+
 }  // namespace ag

@@ -33,7 +33,9 @@ template <class T> Tensor<T> operator*(T s, const Tensor<T>& a) { return mul_sca
 // value or gradient leaves the float range it becomes inf or NaN (never clamped silently):
 // exp (and its gradient, exp itself) overflows above ~88.7 (float32) / ~709.8 (float64).
 template <class T> Tensor<T> exp(const Tensor<T>& x);
-// Needs x > 0: log(0) = -inf with gradient +inf, log(x < 0) = NaN.
+// Needs x > 0: log(0) = -inf with gradient +inf, log(x < 0) = NaN. For x below 1 / the
+// largest float (5.6e-309 float64, 2.9e-39 float32: subnormals) the value is finite but the
+// gradient 1 / x exceeds the largest float: +inf.
 template <class T> Tensor<T> log(const Tensor<T>& x);
 // Needs x >= 0 (NaN below). At exactly 0 the gradient is +inf, and a zero upstream gradient
 // (a masked entry) then gives 0 * inf = NaN: add an eps first where x can reach 0.

@@ -1,5 +1,7 @@
 // Reductions over a 2-D tensor [R x C]. (sum and mean accept any rank.) The means need a
-// non-empty extent (ag::Error on 0 elements, where the mean is undefined).
+// non-empty extent (ag::Error on 0 elements, where the mean is undefined). A mean is the sum
+// divided by the count: inf once that sum exceeds the largest float, even where the mean
+// itself would not (entries near 1e308; the losses in ops_loss.hpp avoid this).
 #pragma once
 
 #include "autograd/tensor.hpp"

@@ -29,7 +29,11 @@ template <class R> Tensor<std::complex<R>> wire(const Tensor<std::complex<R>>& x
 #pragma omp parallel for if (n > kParallelMin)
     for (int64_t i = 0; i < n; ++i) {
       const R a = px[i].real(), b = px[i].imag();
-      const C t = std::conj(g[i]) * psi[i];  // 0 where psi underflowed: no inf * 0
+      const C t = std::conj(g[i]) * psi[i];
+      // psi underflowed to 0 (|x| > ~2.7 / s0) or no gradient flows: the contribution is 0.
+      // Skipped, not multiplied: the factor 2 s0^2 a is inf for |a| > DBL_MAX / (2 s0^2)
+      // (9e305 at s0 = 10; 1.7e36 in float32), and 0 * inf would be NaN.
+      if (t == C(0)) continue;
       const R da = (t * C(-2 * s2 * a, omega0)).real();
       const R db = (t * C(-omega0 - 2 * s2 * b, R(0))).real();
       gx[i] += C(da, db);

@@ -6,8 +6,9 @@
 // instead of overflowing exp(-omega0 b) on its own.
 // Backward (grad g = dL/dRe psi + i dL/dIm psi):
 //     dL/da = Re(conj(g) psi (i omega0 - 2 s0^2 a)),  dL/db = Re(conj(g) psi (-omega0 - 2 s0^2 b)).
-// Valid range: any finite x for s0 > 0 (value and gradient finite and exact from |x| = 0 to
-// 1e8 in float32 and float64). At s0 = 0 the Gaussian envelope is gone and |psi| =
+// Valid range: any finite x for s0 > 0 (value and gradient finite and exact from |x| = 0 up
+// to the largest float, in float32 and float64; where psi underflows to 0 so does the
+// gradient). At s0 = 0 the Gaussian envelope is gone and |psi| =
 // e^{-omega0 b} overflows for b < -88.7 / omega0 (float32); the model config refuses s0 <= 0.
 #pragma once
 

@@ -2,6 +2,8 @@
 // float64 inputs (tolerance 1e-6 relative, see gradcheck.hpp for the definition).
 #include <doctest/doctest.h>
 
+#include <cmath>
+
 #include "autograd/gradcheck_suite.hpp"
 #include "autograd/ops_elementwise.hpp"
 
@@ -41,6 +43,27 @@ TEST_CASE("gradcheck: a planted 2x-wrong gradient is caught at input scales 1e-2
     const auto smooth = ag::gradcheck(
         [s](const std::vector<ag::Tensord>& in) { return ag::tanh(ag::mul_scalar(in[0], 1.0 / s)); }, {x});
     CHECK_MESSAGE(smooth.max_rel_error < 1e-6, smooth.report());
+  }
+}
+
+TEST_CASE("gradcheck: a planted 2x-wrong gradient is caught where the outputs sum beyond the largest double") {
+  // x ~ 1e154: each x |x| is finite (~1e308) but sums of them are not. Summed in double, L
+  // was inf, the difference quotient NaN, and every gradient failed, correct ones too.
+  const double s = 1e154;
+  for (const std::vector<double>& v :
+       {std::vector<double>{0.9, 1.0, 1.2, 1.1, 0.95, 1.3}, std::vector<double>{0.9, -1.0, 1.2, -1.1, 0.95, -1.3}}) {
+    std::vector<double> xs;
+    for (double e : v) xs.push_back(e * s);
+    const ag::Tensord x = ag::Tensord::from({2, 3}, xs);
+    CAPTURE(v[1]);
+    // d/dx x |x| = 2 |x|; through a detached |x| it is |x|.
+    const auto wrong =
+        ag::gradcheck([](const std::vector<ag::Tensord>& in) { return ag::mul(in[0], ag::abs(in[0]).detach()); }, {x});
+    CHECK_MESSAGE(wrong.max_rel_error > 0.4, wrong.report());
+    CHECK(std::isfinite(wrong.numeric));
+    const auto right =
+        ag::gradcheck([](const std::vector<ag::Tensord>& in) { return ag::mul(in[0], ag::abs(in[0])); }, {x});
+    CHECK_MESSAGE(right.max_rel_error < 1e-6, right.report());
   }
 }
 
