@@ -55,6 +55,8 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     gdsr::fail("sim/cloth_solver", "substeps, iterations, stretch_passes and contact_every must be >= 1");
   if (!(p.density > 0) || !(p.stretch_stiffness > 0) || !(p.bend_stiffness > 0))
     gdsr::fail("sim/cloth_solver", "density and stiffnesses must be positive");
+  if (!(p.settle_rest_blend >= 0 && p.settle_rest_blend <= 1))
+    gdsr::fail("sim/cloth_solver", "settle_rest_blend must be in [0, 1]");
   if (!(p.compression_ratio > 0 && p.compression_ratio <= 1))
     gdsr::fail("sim/cloth_solver", "compression_ratio must be in (0, 1]");
   if (body_F.rows() > 0 && body_F.maxCoeff() >= body_V0.rows())
@@ -177,6 +179,14 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     if (!(p.tether_stretch >= 0)) gdsr::fail("sim/cloth_solver", "tether_stretch must be >= 0");
     tethers_ = make_tethers(m, g.pinned);
   }
+  for (const Edge& e : edges_) {
+    edge_rest_pattern_.push_back(e.rest);
+    edge_rest_placed_.push_back((m.V.row(e.i) - m.V.row(e.j)).norm());
+  }
+  for (const Tether& t : tethers_) {
+    tether_rest_pattern_.push_back(t.rest);
+    tether_rest_placed_.push_back(std::max(t.rest, (m.V.row(t.v) - m.V.row(t.pin)).norm()));
+  }
   body_cell_ = cell;
   xprev_ = x_;
   if (p.self_collision) {
@@ -186,6 +196,14 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     self_ = std::make_unique<SelfCollision>(F_, nv);
     motion_ = Points3::Zero(nv, 3);
   }
+}
+
+void ClothSolver::set_rest_blend(double a) {
+  if (!(a >= 0 && a <= 1)) gdsr::fail("sim/cloth_solver", "rest blend must be in [0, 1]");
+  for (size_t c = 0; c < edges_.size(); ++c)
+    edges_[c].rest = edge_rest_placed_[c] + a * (edge_rest_pattern_[c] - edge_rest_placed_[c]);
+  for (size_t c = 0; c < tethers_.size(); ++c)
+    tethers_[c].rest = tether_rest_placed_[c] + a * (tether_rest_pattern_[c] - tether_rest_placed_[c]);
 }
 
 Vec3 ClothSolver::pin_position(const Pin& pin, const Points3& body) const {
@@ -489,10 +507,13 @@ std::vector<Points3> simulate_frames(const Garment& g, const gdsr::Faces& body_F
   // the garment fall only ~0.5 g dt^2 (5 mm at 30 fps) per frame, so the clip would start in
   // the placement shape and the fall would happen during the motion, differently at each resolution.
   solver.set_damping(p.settle_damping);
+  const double blend_frames = std::max(1.0, p.settle_rest_blend * p.settle_frames);
   for (int k = 0; k < p.settle_frames; ++k) {
+    solver.set_rest_blend(std::min(1.0, (k + 1) / blend_frames));
     solver.step(frames[0], frames[0], dt);
     if (progress) progress(++done, total);
   }
+  solver.set_rest_blend(1);
   solver.set_damping(p.damping);
   solver.zero_velocities();
   std::vector<Points3> out;

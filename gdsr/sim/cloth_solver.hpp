@@ -55,6 +55,7 @@ struct SimParams {
                                    // and a hip); cloth pinched between two parts stays on the part it was dressed on
   double max_speed = 15;                         // m/s, velocity clamp (safety against fast body parts)
   int settle_frames = 30;      // frames simulated on the first body pose before frame 0 (velocities zeroed at the end)
+  double settle_rest_blend = 0.5;  // fraction of settle_frames over which rest lengths go from the placement to the pattern
   double settle_damping = 6;   // 1/s, velocity decay while settling: the placed garment falls and swings out within
                                // ~1 s instead of starting the clip in its placement shape
   bool self_collision = true;  // cloth-cloth contact (vertex-triangle and edge-edge)
@@ -79,6 +80,11 @@ class ClothSolver {
   void zero_velocities() { v_.setZero(); }
   // Velocity decay in 1/s from the next step on (the settle damps harder than the clip).
   void set_damping(double per_second) { p_.damping = per_second; }
+  // Rest lengths of edges and tethers from the placement (a = 0) to the pattern (a = 1, the
+  // default). A placement that is not isometric to its pattern (a pants crotch blended into the
+  // hip, a t-shirt's shoulder fold: edges 0.1x to 3x their pattern length) would otherwise snap
+  // back at the speed limit in the first substeps; the settle eases it in instead.
+  void set_rest_blend(double a);
   const gdsr::Points3& positions() const { return x_; }
   const gdsr::Points3& velocities() const { return v_; }       // m/s
   const std::vector<double>& masses() const { return mass_; }  // kg per vertex (pinned too)
@@ -134,6 +140,8 @@ class ClothSolver {
   gdsr::Points3 x_, v_, xprev_;
   std::vector<double> mass_, winv_;
   std::vector<Edge> edges_;
+  std::vector<double> edge_rest_placed_, edge_rest_pattern_;  // m, per edge
+  std::vector<double> tether_rest_placed_, tether_rest_pattern_;  // m, per tether (placed: not below the pattern)
   std::vector<double> edge_scale_;  // per edge, this substep: compliance factor (1 stretched, 1/compression_ratio)
   std::vector<Bend> bends_;
   std::vector<Pin> pins_;

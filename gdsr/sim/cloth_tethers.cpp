@@ -78,8 +78,9 @@ std::vector<Tether> make_tethers(const gdsr::GarmentMesh& m, const std::vector<i
     for (int a : copies[v])
       for (int b : copies[source[v]])
         if (chart[a] == chart[b]) straight = std::min(straight, (m.UV.row(a) - m.UV.row(b)).norm());
-    // A straight line much shorter than the edge path leaves the panel (round a cut-out).
-    const double rest = straight >= dist[v] / 1.2 ? straight : dist[v];
+    // A straight line much shorter than the edge path leaves the panel (round a cut-out); no
+    // shared chart (the pin is on another panel): the edge path.
+    const double rest = std::isfinite(straight) && straight >= dist[v] / 1.2 ? straight : dist[v];
     out.push_back({v, source[v], rest});
   }
   return out;

@@ -6,6 +6,8 @@
 #include "gdsr/error.hpp"
 #include "gdsr/sim/cloth_solver.hpp"
 #include "gdsr/sim/cloth_tethers.hpp"
+#include "gdsr/sim/garments.hpp"
+#include "tests/support/cloth_bodies.hpp"
 #include "tests/support/grid_garment.hpp"
 
 #include <cmath>
@@ -93,4 +95,16 @@ TEST_CASE("tethers: a hanging sheet stretches alike at 30 mm and 10 mm") {
   CHECK(hr_on > 0.99);
   CHECK(std::abs(hr_on - lr_on) < 0.001);
   CHECK(hr_on < hr_off);  // the tethers act where the solver alone does not converge
+}
+
+TEST_CASE("tethers: a pin on another panel gives a finite rest distance along the cloth") {
+  // Pants: the waistband pins are on the front and back panels; vertices whose nearest pin is
+  // across a seam share no UV chart with it, so the rest distance is the edge path's.
+  const gdsr::TriMesh body = sim::make_mannequin(1.7);
+  const sim::Garment g = sim::make_garment("pants", 0.04, body);
+  const auto tethers = sim::make_tethers(g.mesh, g.pinned);
+  REQUIRE(!tethers.empty());
+  int finite = 0;
+  for (const auto& t : tethers) finite += std::isfinite(t.rest) && t.rest > 0;
+  CHECK(finite == static_cast<int>(tethers.size()));
 }
