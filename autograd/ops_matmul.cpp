@@ -128,13 +128,16 @@ Tensor<T> linear_leaky_relu(const Tensor<T>& x, const Tensor<T>& weight, const T
   {
     T* y = out.data();
     const T* b = bias.defined() ? bias.data() : nullptr;
-#pragma omp parallel for if (N * out_f > kParallelMin)
+#pragma omp parallel for firstprivate(slope) if (N * out_f > kParallelMin)
     for (int64_t r = 0; r < N; ++r) {
       T* yr = y + r * out_f;
-      for (int64_t c = 0; c < out_f; ++c) {
-        const T v = b ? yr[c] + b[c] : yr[c];
-        yr[c] = v > 0 ? v : slope * v;
-      }
+      if (b)
+        for (int64_t c = 0; c < out_f; ++c) {
+          const T v = yr[c] + b[c];
+          yr[c] = v > 0 ? v : slope * v;
+        }
+      else
+        for (int64_t c = 0; c < out_f; ++c) yr[c] = yr[c] > 0 ? yr[c] : slope * yr[c];
     }
   }
   std::vector<std::shared_ptr<NodeBase>> parents{x.node_ptr(), weight.node_ptr()};
@@ -146,8 +149,10 @@ Tensor<T> linear_leaky_relu(const Tensor<T>& x, const Tensor<T>& weight, const T
            std::vector<T> g(static_cast<size_t>(n));
            const T* y = on->value.data();
            const T* go = on->grad.data();
-#pragma omp parallel for if (n > kParallelMin)
-           for (int64_t i = 0; i < n; ++i) g[i] = y[i] > 0 ? go[i] : slope * go[i];
+           T* gv = g.data();
+           const T s = slope;
+#pragma omp parallel for firstprivate(s) if (n > kParallelMin)
+           for (int64_t i = 0; i < n; ++i) gv[i] = y[i] > 0 ? go[i] : s * go[i];
            linear_backward<T>(*xn, *wn, bn, g.data());
          });
   return out;
