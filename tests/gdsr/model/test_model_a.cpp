@@ -15,19 +15,34 @@
 
 using namespace gdsr;
 
+namespace {
+// A float64 tiny-preset A, an n x n grid and a smooth z_detail on its vertices; `all` lists
+// every triangle (more of them than vertices: A's per-vertex path).
+struct Setup {
+  ModelConfig cfg = load_model_config(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json");
+  nn::Rng rng;
+  HyperNet<double> a;
+  GarmentMesh m;
+  ag::Tensord z;
+  ag::Index all;
+  Setup(int n, uint64_t seed, double freq) : rng(seed), a(cfg, rng) {
+    m = gdsr_test::grid_garment(gdsr_test::GridSpec::square(n, 0.2));
+    z = ag::Tensord::zeros({m.V.rows(), cfg.a_widths.front() / 3});
+    for (int64_t i = 0; i < z.numel(); ++i) z.data()[i] = std::sin(freq * static_cast<double>(i) + 0.3);
+    all.resize(static_cast<size_t>(m.F.rows()));
+    for (size_t f = 0; f < all.size(); ++f) all[f] = static_cast<int64_t>(f);
+    REQUIRE(static_cast<int64_t>(all.size()) > m.V.rows());
+  }
+};
+}  // namespace
+
 TEST_CASE("model A: field parameters of a triangle are the same asked alone or with every triangle") {
-  const ModelConfig cfg = load_model_config(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json");
-  nn::Rng rng(5);
-  const HyperNet<double> a(cfg, rng);
-  const GarmentMesh m = gdsr_test::grid_garment(gdsr_test::GridSpec::square(5, 0.2));
-  const int64_t V = m.V.rows(), C = cfg.a_widths.front() / 3;
-  ag::Tensord z = ag::Tensord::zeros({V, C});
-  for (int64_t i = 0; i < z.numel(); ++i) z.data()[i] = std::sin(0.7 * static_cast<double>(i) + 0.3);
-  ag::Index all(static_cast<size_t>(m.F.rows())), few{7, 2, 30};
-  for (size_t f = 0; f < all.size(); ++f) all[f] = static_cast<int64_t>(f);
-  REQUIRE(static_cast<int64_t>(all.size()) > V);  // per-vertex path
-  REQUIRE(static_cast<int64_t>(few.size()) < V);  // gathered path
-  const FieldParams<double> p_all = a.parameters_for(m.F, all, z), p_few = a.parameters_for(m.F, few, z);
+  const Setup s(5, 5, 0.7);
+  const HyperNet<double>& a = s.a;
+  const ag::Index& all = s.all;
+  const ag::Index few{7, 2, 30};
+  REQUIRE(static_cast<int64_t>(few.size()) < s.m.V.rows());  // gathered path
+  const FieldParams<double> p_all = a.parameters_for(s.m.F, all, s.z), p_few = a.parameters_for(s.m.F, few, s.z);
   double scale = 0, diff = 0;
   for (size_t i = 0; i < few.size(); ++i)
     for (int64_t j = 0; j < p_all.re.cols(); ++j) {
@@ -42,31 +57,19 @@ TEST_CASE("model A: field parameters of a triangle are the same asked alone or w
 // The whole-model gradient check asks for fewer triangles than vertices; this one checks the
 // per-vertex path (every triangle of the grid), with respect to z_detail.
 TEST_CASE("model A: float64 gradient check with every triangle asked for") {
-  const ModelConfig cfg = load_model_config(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json");
-  nn::Rng rng(6);
-  const HyperNet<double> a(cfg, rng);
-  const GarmentMesh m = gdsr_test::grid_garment(gdsr_test::GridSpec::square(4, 0.2));
-  const int64_t V = m.V.rows(), C = cfg.a_widths.front() / 3;
-  ag::Tensord z = ag::Tensord::zeros({V, C});
-  for (int64_t i = 0; i < z.numel(); ++i) z.data()[i] = std::cos(1.3 * static_cast<double>(i));
-  ag::Index all(static_cast<size_t>(m.F.rows()));
-  for (size_t f = 0; f < all.size(); ++f) all[f] = static_cast<int64_t>(f);
-  REQUIRE(static_cast<int64_t>(all.size()) > V);
+  const Setup s(4, 6, 1.3);
   const auto r = ag::gradcheck(
       [&](const std::vector<ag::Tensord>& in) {
-        const FieldParams<double> p = a.parameters_for(m.F, all, in[0]);
+        const FieldParams<double> p = s.a.parameters_for(s.m.F, s.all, in[0]);
         return ag::add(p.re, ag::mul_scalar(p.im, 0.5));
       },
-      {z});
+      {s.z});
   CHECK(r.checked > 0);
   CHECK_MESSAGE(r.max_rel_error < 1e-6, r.report());  // no leaky ReLU kink lies within a step here
 }
 
 TEST_CASE("model A: z_detail of the wrong width names the op") {
-  const ModelConfig cfg = load_model_config(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json");
-  nn::Rng rng(5);
-  const HyperNet<double> a(cfg, rng);
-  const GarmentMesh m = gdsr_test::grid_garment(gdsr_test::GridSpec::square(3, 0.2));
-  const ag::Tensord z = ag::Tensord::zeros({m.V.rows(), 5});
-  CHECK_THROWS_WITH(a.parameters_for(m.F, ag::Index{0}, z), doctest::Contains("model_a"));
+  const Setup s(4, 5, 0.7);
+  const ag::Tensord z = ag::Tensord::zeros({s.m.V.rows(), 5});
+  CHECK_THROWS_WITH(s.a.parameters_for(s.m.F, ag::Index{0}, z), doctest::Contains("model_a"));
 }
