@@ -85,8 +85,8 @@ template <class T> Tensor<T> conv2d_3x3(const Tensor<T>& x, const Tensor<T>& wei
       im2col(x.data() + n * C * HW, C, H, W, col.data());
       MatMap<T> Y(out.data() + n * O * HW, O, HW);
       const ConstMatMap<T> Col(col.data(), K, HW);
-      gemm::row_blocks(O, K * HW, [&](int64_t r0, int64_t r1) {
-        Y.middleRows(r0, r1 - r0).noalias() = Wm.middleRows(r0, r1 - r0) * Col;
+      gemm::tiles(O, HW, K, [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
+        Y.block(r0, c0, r1 - r0, c1 - c0).noalias() = Wm.middleRows(r0, r1 - r0) * Col.middleCols(c0, c1 - c0);
       });
       if (bias.defined()) Y.colwise() += Eigen::Map<const Eigen::Matrix<T, Eigen::Dynamic, 1>>(bias.data(), O);
     }
@@ -110,15 +110,17 @@ template <class T> Tensor<T> conv2d_3x3(const Tensor<T>& x, const Tensor<T>& wei
                im2col(xn->value.data() + n * C * HW, C, H, W, col.data());
                MatMap<T> dW(wn->grad.data(), O, K);
                const ConstMatMap<T> Col(col.data(), K, HW);
-               gemm::row_blocks(O, K * HW, [&](int64_t r0, int64_t r1) {
-                 dW.middleRows(r0, r1 - r0).noalias() += G.middleRows(r0, r1 - r0) * Col.transpose();
+               gemm::tiles(O, K, HW, [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
+                 dW.block(r0, c0, r1 - r0, c1 - c0).noalias() +=
+                     G.middleRows(r0, r1 - r0) * Col.middleRows(c0, c1 - c0).transpose();
                });
              }
              if (need_b) Eigen::Map<Eigen::Matrix<T, Eigen::Dynamic, 1>>(bn->grad.data(), O) += G.rowwise().sum();
              if (need_x) {
                MatMap<T> Col(col.data(), K, HW);
-               gemm::row_blocks(K, O * HW, [&](int64_t r0, int64_t r1) {
-                 Col.middleRows(r0, r1 - r0).noalias() = Wm.middleCols(r0, r1 - r0).transpose() * G;
+               gemm::tiles(K, HW, O, [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
+                 Col.block(r0, c0, r1 - r0, c1 - c0).noalias() =
+                     Wm.middleCols(r0, r1 - r0).transpose() * G.middleCols(c0, c1 - c0);
                });
                col2im_add(col.data(), C, H, W, xn->grad.data() + n * C * HW);
              }

@@ -6,7 +6,7 @@
 #include <string>
 
 namespace ag {
-using gemm::row_blocks;
+using gemm::tiles;
 
 // C = A B.  dA = G B^H,  dB = A^H G  (H = conjugate transpose; plain transpose for reals).
 template <class T> Tensor<T> matmul(const Tensor<T>& a, const Tensor<T>& b) {
@@ -18,9 +18,9 @@ template <class T> Tensor<T> matmul(const Tensor<T>& a, const Tensor<T>& b) {
   {
     MatMap<T> C = out.mat();
     const ConstMatMap<T> A = a.mat(), B = b.mat();
-    row_blocks(A.rows(), A.cols() * B.cols(), [&](int64_t r0, int64_t r1) {
-      C.middleRows(r0, r1 - r0).noalias() += A.middleRows(r0, r1 - r0) * B;  // output zeroed already
-    });
+    tiles(A.rows(), B.cols(), A.cols(), [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
+      C.block(r0, c0, r1 - r0, c1 - c0).noalias() += A.middleRows(r0, r1 - r0) * B.middleCols(c0, c1 - c0);
+    });  // output zeroed already
   }
   record(out.node(), {a.node_ptr(), b.node_ptr()}, [an = &a.node(), bn = &b.node(), on = &out.node()] {
     const int64_t M = an->shape[0], K = an->shape[1], N = bn->shape[1];
@@ -28,15 +28,15 @@ template <class T> Tensor<T> matmul(const Tensor<T>& a, const Tensor<T>& b) {
     if (an->requires_grad) {
       an->ensure_grad();
       MatMap<T> dA(an->grad.data(), M, K);
-      row_blocks(M, K * N, [&](int64_t r0, int64_t r1) {
-        dA.middleRows(r0, r1 - r0).noalias() += G.middleRows(r0, r1 - r0) * B.adjoint();
+      tiles(M, K, N, [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
+        dA.block(r0, c0, r1 - r0, c1 - c0).noalias() += G.middleRows(r0, r1 - r0) * B.middleRows(c0, c1 - c0).adjoint();
       });
     }
     if (bn->requires_grad) {
       bn->ensure_grad();
       MatMap<T> dB(bn->grad.data(), K, N);
-      row_blocks(K, M * N, [&](int64_t r0, int64_t r1) {
-        dB.middleRows(r0, r1 - r0).noalias() += A.middleCols(r0, r1 - r0).adjoint() * G;
+      tiles(K, N, M, [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
+        dB.block(r0, c0, r1 - r0, c1 - c0).noalias() += A.middleCols(r0, r1 - r0).adjoint() * G.middleCols(c0, c1 - c0);
       });
     }
   });
@@ -64,15 +64,16 @@ template <class T> void linear_backward(Node<T>& xn, Node<T>& wn, Node<T>* bn, c
   if (xn.requires_grad) {
     xn.ensure_grad();
     MatMap<T> dX(xn.grad.data(), N, I);
-    row_blocks(N, O * I, [&](int64_t r0, int64_t r1) {
-      dX.middleRows(r0, r1 - r0).noalias() += G.middleRows(r0, r1 - r0) * W.conjugate();
+    tiles(N, I, O, [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
+      dX.block(r0, c0, r1 - r0, c1 - c0).noalias() += G.middleRows(r0, r1 - r0) * W.middleCols(c0, c1 - c0).conjugate();
     });
   }
   if (wn.requires_grad) {
     wn.ensure_grad();
     MatMap<T> dW(wn.grad.data(), O, I);
-    row_blocks(O, N * I, [&](int64_t r0, int64_t r1) {
-      dW.middleRows(r0, r1 - r0).noalias() += G.middleCols(r0, r1 - r0).transpose() * X.conjugate();
+    tiles(O, I, N, [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
+      dW.block(r0, c0, r1 - r0, c1 - c0).noalias() +=
+          G.middleCols(r0, r1 - r0).transpose() * X.middleCols(c0, c1 - c0).conjugate();
     });
   }
   if (bn && bn->requires_grad) {
@@ -87,8 +88,8 @@ template <class T> void linear_backward(Node<T>& xn, Node<T>& wn, Node<T>* bn, c
 // Y += X W^T in row blocks (Y is a fresh, zeroed output).
 template <class T> void gemm_xwt(const Tensor<T>& x, const Tensor<T>& weight, MatMap<T>& Y) {
   const ConstMatMap<T> X = x.mat(), W = weight.mat();
-  row_blocks(X.rows(), X.cols() * W.rows(), [&](int64_t r0, int64_t r1) {
-    Y.middleRows(r0, r1 - r0).noalias() += X.middleRows(r0, r1 - r0) * W.transpose();
+  tiles(X.rows(), W.rows(), X.cols(), [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
+    Y.block(r0, c0, r1 - r0, c1 - c0).noalias() += X.middleRows(r0, r1 - r0) * W.middleRows(c0, c1 - c0).transpose();
   });
 }
 }  // namespace
@@ -127,13 +128,16 @@ Tensor<T> linear_leaky_relu(const Tensor<T>& x, const Tensor<T>& weight, const T
   {
     T* y = out.data();
     const T* b = bias.defined() ? bias.data() : nullptr;
-#pragma omp parallel for if (N * out_f > kParallelMin)
+#pragma omp parallel for firstprivate(slope) if (N * out_f > kParallelMin)
     for (int64_t r = 0; r < N; ++r) {
       T* yr = y + r * out_f;
-      for (int64_t c = 0; c < out_f; ++c) {
-        const T v = b ? yr[c] + b[c] : yr[c];
-        yr[c] = v > 0 ? v : slope * v;
-      }
+      if (b)
+        for (int64_t c = 0; c < out_f; ++c) {
+          const T v = yr[c] + b[c];
+          yr[c] = v > 0 ? v : slope * v;
+        }
+      else
+        for (int64_t c = 0; c < out_f; ++c) yr[c] = yr[c] > 0 ? yr[c] : slope * yr[c];
     }
   }
   std::vector<std::shared_ptr<NodeBase>> parents{x.node_ptr(), weight.node_ptr()};
@@ -145,8 +149,10 @@ Tensor<T> linear_leaky_relu(const Tensor<T>& x, const Tensor<T>& weight, const T
            std::vector<T> g(static_cast<size_t>(n));
            const T* y = on->value.data();
            const T* go = on->grad.data();
-#pragma omp parallel for if (n > kParallelMin)
-           for (int64_t i = 0; i < n; ++i) g[i] = y[i] > 0 ? go[i] : slope * go[i];
+           T* gv = g.data();
+           const T s = slope;
+#pragma omp parallel for firstprivate(s) if (n > kParallelMin)
+           for (int64_t i = 0; i < n; ++i) gv[i] = y[i] > 0 ? go[i] : s * go[i];
            linear_backward<T>(*xn, *wn, bn, g.data());
          });
   return out;

@@ -2,13 +2,16 @@
 // vertices, 121 x 121 = 14,641 HR vertices, one UV square): inference per frame (all HR
 // vertices, NoGradGuard) and a training step (forward on the HR vertices of 8 patches of
 // 80 x 80 pixels of a 1024 raster, L1 on C_hat and G, backward), per preset.
-// Counters: share of each block in the forward (features, H, E, A, field), the model's
-// GFLOP per call (multiply-adds x 2 of its linear maps, from the architecture) and GFLOP/s.
+// Counters: seconds and share of each block in the forward (features, H, E, A, field), the
+// model's GFLOP per call (multiply-adds x 2 of its linear maps, from the architecture),
+// GFLOP/s and the process's peak memory (MiB). Each benchmark makes one untimed call first.
 // Float32 vs float64 inference (same weights): s/frame of each and the largest difference
 // of the HR output G in mm. A dense Eigen GEMM is timed in the same run as the yardstick for
 // a loaded machine (compare GFLOP/s ratios, not seconds). The program runs with passive
 // OpenMP waiting unless OMP_WAIT_POLICY is set, and with large blocks kept in the heap
-// (autograd/runtime.hpp).
+// (autograd/runtime.hpp). bench/preset_table.sh prints the per-preset table (one process per
+// figure, so that peak memory is that figure's own); --reference_out / --reference_in check
+// that a speed change leaves the output unchanged (see main).
 #include <benchmark/benchmark.h>
 
 #include "autograd/autograd.hpp"
@@ -20,11 +23,16 @@
 #include "gdsr/model/frames.hpp"
 #include "tests/support/grid_garment.hpp"
 
+#include <sys/resource.h>
+
 #include <chrono>
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 using namespace gdsr;
 
@@ -124,21 +132,38 @@ GDSR<float>& model(const std::string& preset) {
   return *m;
 }
 
+// Peak resident memory of this process so far (MiB).
+double peak_rss_mib() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_maxrss) / 1024.0;
+}
+
+// Forward seconds per call of each block (H_s, E_s, A_s, field_s: compare with the PyTorch
+// script's per-block figures), their shares, the model's GFLOP and rate, peak memory.
 void set_counters(benchmark::State& st, const GdsrTimings& t, int iters, const Flops& f, double seconds_per_iter) {
-  const double sum = t.features + t.h + t.e + t.a + t.field;
+  const double sum = t.features + t.h + t.e + t.a + t.field, n = std::max(1, iters);
   st.counters["features_%"] = 100 * t.features / sum;
   st.counters["H_%"] = 100 * t.h / sum;
   st.counters["E_%"] = 100 * t.e / sum;
   st.counters["A_%"] = 100 * t.a / sum;
   st.counters["field_%"] = 100 * t.field / sum;
+  st.counters["H_s"] = t.h / n;
+  st.counters["E_s"] = t.e / n;
+  st.counters["A_s"] = t.a / n;
+  st.counters["field_s"] = t.field / n;
   st.counters["GFLOP"] = f.total();
   st.counters["GFLOP/s"] = f.total() / seconds_per_iter;
-  (void)iters;
+  st.counters["peak_MiB"] = peak_rss_mib();
 }
 
 void BM_Inference(benchmark::State& st, const std::string& preset) {
   const Scene& s = scene();
   GDSR<float>& m = model(preset);
+  {
+    ag::NoGradGuard ng;  // warm-up: the heap grows once, as in the first frame of a roll-out
+    m.forward(s.graph, s.in, &s.all, nullptr, nullptr);
+  }
   GdsrTimings t;
   int iters = 0;
   double secs = 0;
@@ -178,7 +203,7 @@ GDSR<double>& model64(const std::string& preset, double* max_diff_mm) {
 void BM_Inference64(benchmark::State& st, const std::string& preset) {
   const Scene& s = scene();
   double diff_mm = 0;
-  GDSR<double>& m = model64(preset, &diff_mm);
+  GDSR<double>& m = model64(preset, &diff_mm);  // includes a first (warm-up) call
   GdsrTimings t;
   int iters = 0;
   double secs = 0;
@@ -202,8 +227,8 @@ void BM_DenseGemmReference(benchmark::State& st) {
   const M a = M::Random(2048, 512), b = M::Random(4096, 512);
   M c(2048, 4096);
   for (auto _ : st) {
-    ag::gemm::row_blocks(a.rows(), a.cols() * b.rows(), [&](int64_t r0, int64_t r1) {
-      c.middleRows(r0, r1 - r0).noalias() = a.middleRows(r0, r1 - r0) * b.transpose();
+    ag::gemm::tiles(a.rows(), b.rows(), a.cols(), [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
+      c.block(r0, c0, r1 - r0, c1 - c0).noalias() = a.middleRows(r0, r1 - r0) * b.middleRows(c0, c1 - c0).transpose();
     });
     benchmark::DoNotOptimize(c.data());
   }
@@ -221,18 +246,22 @@ void BM_TrainStep(benchmark::State& st, const std::string& preset) {
     G_t.row(i) = p;
   }
   const ag::Tensorf G_target = to_tensor<float>(G_t), C_target = to_tensor<float>(s.lr.V);
-  GdsrTimings t;
   nn::Rng noise(1);
+  auto step = [&](GdsrTimings* t) {
+    auto out = m.forward(s.graph, s.in, &s.patches, &noise, t);
+    auto loss = ag::add(ag::l1_loss(out.C_hat, C_target), ag::l1_loss(out.G, G_target));
+    loss.backward();
+    m.zero_grad();
+    return static_cast<int64_t>(out.faces.size());
+  };
+  step(nullptr);  // warm-up: the heap grows once, as in the first step of a training run
+  GdsrTimings t;
   int iters = 0;
   double secs = 0;
   int64_t faces = 0;
   for (auto _ : st) {
     const auto t0 = std::chrono::steady_clock::now();
-    auto out = m.forward(s.graph, s.in, &s.patches, &noise, &t);
-    faces = static_cast<int64_t>(out.faces.size());
-    auto loss = ag::add(ag::l1_loss(out.C_hat, C_target), ag::l1_loss(out.G, G_target));
-    loss.backward();
-    m.zero_grad();
+    faces = step(&t);
     secs += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ++iters;
   }
@@ -251,19 +280,59 @@ BENCHMARK_CAPTURE(BM_Inference, paper, std::string("paper"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(3.0);
+BENCHMARK_CAPTURE(BM_Inference64, tiny, std::string("tiny"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Inference64, small, std::string("small"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Inference64, paper, std::string("paper"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(3.0);
 BENCHMARK(BM_DenseGemmReference)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_TrainStep, tiny, std::string("tiny"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_TrainStep, small, std::string("small"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_TrainStep, paper, std::string("paper"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(3.0);
 
+// --reference_out=FILE writes the float32 inference output G (metres) of each preset's seeded
+// model on the bench garment; --reference_in=FILE compares today's G with such a file and
+// fails when any coordinate moved by 1e-5 m or more (a speed change must not change results).
+int reference_check(const std::string& arg) {
+  const bool write = arg.rfind("--reference_out=", 0) == 0;
+  const std::string path = arg.substr(arg.find('=') + 1);
+  std::FILE* f = std::fopen(path.c_str(), write ? "wb" : "rb");
+  if (!f) {
+    std::fprintf(stderr, "bench_model: cannot open %s\n", path.c_str());
+    return 1;
+  }
+  int status = 0;
+  for (const std::string preset : {"tiny", "small", "paper"}) {
+    ag::NoGradGuard ng;
+    const Scene& s = scene();
+    const auto out = model(preset).forward(s.graph, s.in, &s.all, nullptr, nullptr);
+    std::vector<double> g(out.G.data(), out.G.data() + out.G.numel()), ref(g.size());
+    if (write) {
+      std::fwrite(g.data(), sizeof(double), g.size(), f);
+      continue;
+    }
+    if (std::fread(ref.data(), sizeof(double), ref.size(), f) != ref.size()) {
+      std::fprintf(stderr, "bench_model: %s is too short for preset %s\n", path.c_str(), preset.c_str());
+      status = 1;
+      break;
+    }
+    double d = 0;
+    for (size_t i = 0; i < g.size(); ++i) d = std::max(d, std::abs(g[i] - ref[i]));
+    std::printf("%s: max |G - G_ref| = %.3g m\n", preset.c_str(), d);
+    if (!(d < 1e-5)) status = 1;
+  }
+  std::fclose(f);
+  return status;
+}
+
 int main(int argc, char** argv) {
   ag::configure_runtime(argv);
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]).rfind("--reference_", 0) == 0) return reference_check(argv[i]);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::AddCustomContext("omp_wait_policy", ag::openmp_wait_policy());

@@ -3,7 +3,12 @@
 # in one run (ours, torch, ours, torch, ...) because the machine is shared: compare the
 # ratios, not the seconds. Also prints our dense-GEMM yardstick (GFLOP/s) each round.
 #   bench/run_interleaved.sh BUILD_DIR [ROUNDS] [THREADS] [--train]
-# With --train the training steps are compared instead (ours: BM_TrainStep/paper).
+# With --train the training steps are compared instead (ours: BM_TrainStep/paper, without
+# VGG and optimiser; the script's step includes VGG19 to relu5_1 and AdamW).
+# Compare per block: our counters H_s, E_s, A_s, field_s with the script's H, E, A, field.
+# The PyTorch side is bench-only and not part of scripts/setup.sh; install it with
+#   apt-get install -y python3-torch python3-torchvision libopenblas0-pthread
+# (without libopenblas0-pthread torch uses the reference BLAS, ~15x slower).
 set -e
 build=$(cd "${1:?usage: $0 BUILD_DIR [ROUNDS] [THREADS] [--train]}" && pwd)
 rounds=${2:-2}

@@ -18,9 +18,13 @@ template <class T> MLPBlock<T>::MLPBlock(int64_t in, int64_t out, bool norm, boo
 template <class T> ag::Tensor<T> MLPBlock<T>::forward(const ag::Tensor<T>& x) const {
   const T slope = static_cast<T>(kSlope);
   // Bias and activation fused into the GEMMs' output pass where they follow directly.
-  ag::Tensor<T> h = ag::linear_leaky_relu(x, linear1->weight, linear1->bias, slope);
-  if (!norm_ && !scale.defined()) return ag::linear_leaky_relu(h, linear2->weight, linear2->bias, slope);
-  h = linear2->forward(h);
+  return after_first(ag::linear_leaky_relu(x, linear1->weight, linear1->bias, slope));
+}
+
+template <class T> ag::Tensor<T> MLPBlock<T>::after_first(const ag::Tensor<T>& h1) const {
+  const T slope = static_cast<T>(kSlope);
+  if (!norm_ && !scale.defined()) return ag::linear_leaky_relu(h1, linear2->weight, linear2->bias, slope);
+  ag::Tensor<T> h = linear2->forward(h1);
   if (norm_) h = ag::channel_norm(h);
   if (scale.defined()) h = ag::add(ag::add(h, ag::mul(h, scale)), shift);  // h (1 + s) + b
   return ag::leaky_relu(h, slope);

@@ -17,6 +17,9 @@ template <class T> class MLPBlock : public Module<T> {
   MLPBlock(int64_t in, int64_t out, bool norm, bool scale_shift, Rng& rng);
   // x [N x in] -> [N x out]. With norm, the statistics are over the N rows.
   ag::Tensor<T> forward(const ag::Tensor<T>& x) const;
+  // The block after its first linear map and activation: forward(x) == after_first(
+  // leaky_relu(linear1(x))). For callers that compute linear1 in parts (model_h's edges).
+  ag::Tensor<T> after_first(const ag::Tensor<T>& h) const;
 
   std::shared_ptr<Linear<T>> linear1, linear2;
   ag::Tensor<T> scale, shift;  // undefined without scale_shift

@@ -116,7 +116,7 @@ template <class T> GdsrOutput<T> GDSR<T>::decode(const GarmentGraph& g, const ag
   auto restore = [&](const ag::Tensor<T>& x) { return sorted ? x : ag::index_select_rows(x, back); };
 
   t0 = Clock::now();
-  out.field = a_->parameters_for(gather_face_features(g.F, out.faces, ag::slice_cols(z, 0, zd)));
+  out.field = a_->parameters_for(g.F, out.faces, ag::slice_cols(z, 0, zd));
   if (timings) timings->a += since(t0);
   t0 = Clock::now();
   const ag::Tensor<T> r_local = a_->eval_field(out.field, bary, group);

@@ -3,6 +3,7 @@
 #include "gdsr/error.hpp"
 
 #include "autograd/autograd.hpp"
+#include "gdsr/model/model_e.hpp"
 
 #include <algorithm>
 #include <complex>
@@ -25,11 +26,33 @@ template <class T> HyperNet<T>::HyperNet(const ModelConfig& cfg, nn::Rng& rng) :
   field_scale = this->register_parameter("field_scale", s);
 }
 
-template <class T> FieldParams<T> HyperNet<T>::parameters_for(const ag::Tensor<T>& face_z) const {
-  if (face_z.cols() != cfg_.a_widths.front())
-    gdsr::fail("model_a", "face features must have " + std::to_string(cfg_.a_widths.front()) + " columns, got " +
-                              ag::shape_str(face_z.shape()));
-  const ag::Tensor<T> h = mlp_->forward(face_z);
+template <class T>
+FieldParams<T> HyperNet<T>::parameters_for(const Faces& F, const ag::Index& faces, const ag::Tensor<T>& z) const {
+  const int64_t C = z.cols();
+  if (3 * C != cfg_.a_widths.front())
+    gdsr::fail("model_a", "z_detail must have " + std::to_string(cfg_.a_widths.front() / 3) + " columns, got " +
+                              ag::shape_str(z.shape()));
+  const nn::MLPBlock<T>& first = *mlp_->blocks.front();
+  ag::Tensor<T> h;
+  if (static_cast<int64_t>(faces.size()) > z.rows()) {
+    // More triangles than vertices (a whole frame has ~2 per vertex): the first linear map
+    // per corner block on z's V rows, gathered to the triangles, rather than on three copies
+    // of every vertex's row. Equal up to rounding.
+    const ag::Tensor<T>& W = first.linear1->weight;
+    ag::Tensor<T> pre;
+    for (int k = 0; k < 3; ++k) {
+      ag::Index corner(faces.size());
+      for (size_t i = 0; i < faces.size(); ++i) corner[i] = F(faces[i], k);
+      const ag::Tensor<T> zk =
+          ag::linear(z, ag::slice_cols(W, k * C, (k + 1) * C), k == 0 ? first.linear1->bias : ag::Tensor<T>());
+      const ag::Tensor<T> g = ag::index_select_rows(zk, corner);
+      pre = k == 0 ? g : ag::add(pre, g);
+    }
+    h = first.after_first(ag::leaky_relu(pre, static_cast<T>(nn::MLPBlock<T>::kSlope)));
+  } else {
+    h = first.forward(gather_face_features(F, faces, z));
+  }
+  for (size_t b = 1; b < mlp_->blocks.size(); ++b) h = mlp_->blocks[b]->forward(h);
   return {proj_re_->forward(h), proj_im_->forward(h)};
 }
 

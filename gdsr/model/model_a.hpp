@@ -6,6 +6,7 @@
 #pragma once
 
 #include "autograd/tensor.hpp"
+#include "gdsr/geometry/mesh.hpp"
 #include "gdsr/model/model_config.hpp"
 #include "nn/linear.hpp"
 #include "nn/mlp.hpp"
@@ -22,8 +23,9 @@ template <class T> class HyperNet : public nn::Module<T> {
  public:
   HyperNet(const ModelConfig& cfg, nn::Rng& rng);
 
-  // face_z: [F_needed x 3 z_detail] (gather_face_features of z_detail) -> field parameters.
-  FieldParams<T> parameters_for(const ag::Tensor<T>& face_z) const;
+  // Field parameters [faces.size() x P] of the triangles `faces` of F from z_detail [V x C]
+  // (A's input per triangle: its three corners' rows, concatenated: gather_face_features).
+  FieldParams<T> parameters_for(const Faces& F, const ag::Index& faces, const ag::Tensor<T>& z_detail) const;
 
   // bary [N x 3] (constant), group: N indices into the rows of p -> local residual
   // [N x 3] = tanh(Re(field(bary))) * field_scale.

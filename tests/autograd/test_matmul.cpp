@@ -1,6 +1,8 @@
 // Gradient checks of matmul, linear and transpose (real and complex).
 #include "tests/support/ag_test_util.hpp"
 
+#include "autograd/gemm_blocks.hpp"
+
 using namespace agt;
 using ag::Tensorcd;
 
@@ -91,4 +93,30 @@ TEST_CASE("linear_leaky_relu: gradient, and equal to leaky_relu(linear) bit for 
   for (size_t k = 0; k < f.size(); ++k) CHECK(f[k] == u[k]);
   CHECK_THROWS_WITH_AS(ag::linear_leaky_relu(x, w, b, 0.0), doctest::Contains("linear_leaky_relu"), ag::Error);
   CHECK_THROWS_WITH_AS(ag::linear_leaky_relu(x, randn({4, 3}, 18), b, 0.1), doctest::Contains("[7 x 5]"), ag::Error);
+}
+
+// Products big enough to be cut into tiles (autograd/gemm_blocks.hpp) give one whole Eigen
+// product's values and gradients, also where the tiles run on several threads.
+TEST_CASE("matmul and linear: tiled products equal one whole product") {
+  const int64_t M = 300, K = 1000, N = 700;
+  const ag::gemm::Tiling t = ag::gemm::tiling(M, N, K);
+  REQUIRE(t.row_tiles * t.col_tiles > 2);  // the shape really is split, in both directions
+  REQUIRE(t.col_tiles > 1);
+  Tensord a = randn({M, K}, 11), b = randn({K, N}, 12), w = randn({N, K}, 13), r = randn({M, N}, 14);
+  a.set_requires_grad(true), b.set_requires_grad(true), w.set_requires_grad(true);
+  const Eigen::MatrixXd A = a.mat(), B = b.mat(), W = w.mat(), R = r.mat();
+  auto err = [](const Eigen::MatrixXd& x, const Eigen::MatrixXd& ref) {
+    return (x - ref).cwiseAbs().maxCoeff() / ref.cwiseAbs().maxCoeff();
+  };
+  const Tensord c = ag::matmul(a, b);
+  CHECK(err(c.mat(), A * B) < 1e-13);
+  ag::sum(ag::mul(c, r)).backward();  // dA = R B^T, dB = A^T R
+  CHECK(err(a.grad_mat(), R * B.transpose()) < 1e-13);
+  CHECK(err(b.grad_mat(), A.transpose() * R) < 1e-13);
+  a.zero_grad();
+  const Tensord y = ag::linear(a, w, Tensord());
+  CHECK(err(y.mat(), A * W.transpose()) < 1e-13);
+  ag::sum(ag::mul(y, r)).backward();  // dX = R W, dW = R^T X
+  CHECK(err(a.grad_mat(), R * W) < 1e-13);
+  CHECK(err(w.grad_mat(), R.transpose() * A) < 1e-13);
 }
