@@ -157,6 +157,7 @@ class ClothSolver {
   gdsr::Points3 x_detect_;      // positions at the last self-contact detection
   gdsr::Points3 motion_;        // m, per vertex: predicted motion until the next detection
   int since_detect_ = 1 << 30;  // substeps since the last detection
+  int detect_interval_ = 1;     // substeps the last detection covers (self_detect_every or fewer for fast cloth)
   bool tangle_test_due_ = true;  // the next detection also runs the tangle test (once per frame)
 };
 

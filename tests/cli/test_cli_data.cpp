@@ -121,7 +121,7 @@ TEST_CASE("cli data: make a tiny dataset, check it and preview a frame") {
   check_one_line_error(gdsr_run(dir, "data make --garment no_such_garment --out '" + (dir / "x") + "'"), "garment");
 }
 
-TEST_CASE("cli data: solver knobs reach the solver and the manifest; values out of range are refused") {
+TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out of range are refused") {
   TempDir dir("cli_knobs");
   const std::string out = dir / "ds";
   const Run mk = gdsr_run(dir, "data make --garment skirt_short --out '" + out +

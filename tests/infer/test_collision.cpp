@@ -56,7 +56,7 @@ TEST_CASE("collision: body pass pushes penetrating HR vertices to sigma_b and le
   CHECK(!st.layers_checked);  // single layer: no layer work
 }
 
-TEST_CASE("collision: no body means no query; switching the body pass off too") {
+TEST_CASE("collision: no body means no query / switching the body pass off too") {
   Points3 C(1, 3);
   C << 0, -0.1, 0;
   Points3 G(1, 3);

@@ -4,7 +4,7 @@
 #include "infer/evaluate.hpp"
 #include "tests/support/data_fixtures.hpp"
 
-TEST_CASE("evaluate: the ground truth scores error 0 and SSIM 1; the LR baseline does worse") {
+TEST_CASE("evaluate: the ground truth scores error 0 and SSIM 1 / the LR baseline does worse") {
   const gdsr::Dataset d = gdsr_test::wave_dataset(4);
   const gdsr::Evaluation e = gdsr::evaluate(d, {d.hr_frames[1], d.hr_frames[2]}, 1);
   CHECK(e.frames.size() == 2);

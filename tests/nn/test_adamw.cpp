@@ -94,7 +94,7 @@ TEST_CASE("AdamW: first step moves by lr * sign(g) after decoupled decay") {
   CHECK(p.values()[1] == doctest::Approx(-3.0 * (1 - 0.005) - 0.01 * 1e-3 / (1e-3 + 1e-8)).epsilon(1e-14));
 }
 
-TEST_CASE("AdamW: parameters without a gradient are skipped; complex parameters update as real pairs") {
+TEST_CASE("AdamW: parameters without a gradient are skipped / complex parameters update as real pairs") {
   ag::Tensord a = ag::Tensord::from({1, 1}, {1.0}, true), b = ag::Tensord::from({1, 1}, {2.0}, true);
   ag::Tensorcd z = ag::Tensorcd::from({1, 1}, {std::complex<double>(0.5, -0.25)}, true);
   ag::Tensord re = ag::Tensord::from({1, 2}, {0.5, -0.25}, true);
@@ -121,7 +121,7 @@ TEST_CASE("AdamW: parameters without a gradient are skipped; complex parameters 
   CHECK(z.values()[0].imag() == doctest::Approx(re.values()[1]).epsilon(1e-14));
 }
 
-TEST_CASE("schedules: step decay halves every N steps down to the floor; loss-weight ramp") {
+TEST_CASE("schedules: step decay halves every N steps down to the floor / loss-weight ramp") {
   nn::StepDecay sd{1e-4, 0.5, 100, 1e-6};
   CHECK(sd(0) == 1e-4);
   CHECK(sd(99) == 1e-4);

@@ -67,7 +67,7 @@ TEST_CASE("Module: dotted names in registration order, counts, zero_grad, duplic
   CHECK_THROWS_AS(Bad(), ag::Error);
 }
 
-TEST_CASE("Linear: PyTorch default init bounds 1/sqrt(in) for weight and bias; forward = x W^T + b") {
+TEST_CASE("Linear: PyTorch default init bounds 1/sqrt(in) for weight and bias / forward = x W^T + b") {
   nn::Rng rng(7);
   nn::Linear<double> lin(64, 300, true, rng);
   const double bound = 1.0 / 8.0;
@@ -114,7 +114,7 @@ TEST_CASE("init: Xavier-uniform and Kaiming bounds") {
   CHECK(hi > 0.95 * std::sqrt(6.0 / 50));
 }
 
-TEST_CASE("MLPBlock: forward matches its definition; float64 gradient check with norm and scale/shift") {
+TEST_CASE("MLPBlock: forward matches its definition / float64 gradient check with norm and scale/shift") {
   nn::Rng rng(11);
   nn::MLPBlock<double> blk(3, 4, true, true, rng);
   for (auto& v : blk.scale.values()) v = rng.uniform(-0.5, 0.5);
@@ -200,7 +200,7 @@ TEST_CASE("ComplexLinear: WIRE init bounds per real/imaginary part, forward = x 
     }
 }
 
-TEST_CASE("copy_parameters: float <-> double by name; mismatches refused") {
+TEST_CASE("copy_parameters: float <-> double by name / mismatches refused") {
   nn::Rng r1(1), r2(2);
   nn::MLPStack<double> d({4, 8, 3}, true, true, r1);
   nn::MLPStack<float> f({4, 8, 3}, true, true, r2);

@@ -23,7 +23,7 @@ TEST_CASE("MLP regression in float32: training loss drops by more than 100x, tes
   CHECK(r.test_loss < 10.0 * r.final_loss + 1e-3);
 }
 
-TEST_CASE("train_demo_mlp: deterministic per seed; bad options refused") {
+TEST_CASE("train_demo_mlp: deterministic per seed / bad options refused") {
   nn::DemoMlpOptions opt;
   opt.steps = 20;
   const auto a = nn::train_demo_mlp(opt), b = nn::train_demo_mlp(opt);

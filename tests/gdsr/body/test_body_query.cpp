@@ -221,7 +221,7 @@ TEST_CASE("body_query: rays hit a cube where expected") {
   CHECK(in.t[0] == doctest::Approx(0.4));
 }
 
-TEST_CASE("body_query: update moves the surface; bad input gives clear errors") {
+TEST_CASE("body_query: update moves the surface / bad input gives clear errors") {
   const TriMesh s = bq_icosphere(0.3, 2);
   BodyQuery bq(s);
   Points3 Q(3, 3);

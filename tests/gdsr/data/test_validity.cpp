@@ -170,7 +170,7 @@ TEST_CASE("gdsr: validity counts the HR frames that overlap themselves, on every
   CHECK_THROWS_AS(gdsr::measure_validity(d, opt), gdsr::Error);
 }
 
-TEST_CASE("gdsr: validity wrinkles: HR ripples above LR upsampled; figures survive the manifest") {
+TEST_CASE("gdsr: validity wrinkles: HR ripples above LR upsampled / figures survive the manifest") {
   const gdsr::Dataset d = gdsr_test::wave_dataset(5);
   const gdsr::ValidityFigures v = gdsr::measure_validity(d);
   double up = 0;

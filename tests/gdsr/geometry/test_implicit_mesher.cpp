@@ -46,7 +46,7 @@ TEST_CASE("implicit mesher: a sphere of radius 0.1 m is closed, outward, on the 
   CHECK(m2.F == m.F);
 }
 
-TEST_CASE("implicit mesher: two overlapping spheres make one closed surface; no surface throws") {
+TEST_CASE("implicit mesher: two overlapping spheres make one closed surface / no surface throws") {
   auto two = [](const gdsr::Vec3& p) {
     return std::min((p - gdsr::Vec3(-0.05, 0, 0)).norm() - 0.08, (p - gdsr::Vec3(0.05, 0, 0)).norm() - 0.08);
   };

@@ -16,7 +16,7 @@ TEST_CASE("strain energies: zero for the flat rest sheet, (s - 1)^2 for a unifor
   CHECK(st.E_v == doctest::Approx(0).epsilon(1e-12));
 }
 
-TEST_CASE("strain energies: shear (w_u . w_v)^2 of a simple shear; degenerate UV triangles left out") {
+TEST_CASE("strain energies: shear (w_u . w_v)^2 of a simple shear / degenerate UV triangles left out") {
   gdsr::GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec(3, 3, 0.2, 0.2));
   gdsr::Points3 s = g.V;
   s.col(0) += 0.5 * g.V.col(1);  // x += 0.5 y: w_u = (1, 0, 0), w_v = (0.5, 1, 0)
