@@ -191,6 +191,7 @@ void run_make(const MakeArgs& a) {
                   {"settle_frames", params.settle_frames},
                   {"contact_every", params.contact_every},
                   {"settle_damping_1_s", params.settle_damping},
+                  {"settle_rest_blend", params.settle_rest_blend},
                   {"self_collision", params.self_collision},
                   {"self_thickness_m", params.self_thickness},
                   {"self_slack_m", params.self_slack},
