@@ -313,7 +313,7 @@ void ClothSolver::detect_self_contacts(double h) {
   // On the current (intersection-free) state, covering the motion of the next
   // self_detect_every substeps; sooner when a vertex left its slack (track_self_slack).
   // The tangle test (edges crossing faces) runs at the first detection of each frame only:
-  // it is a third of a detection's cost, and an intersection that slipped through stays
+  // it was a fifth of a detection's time, and an intersection that slipped through stays
   // guarded for at most one frame before it is freed to untangle.
   //
   // The interval adapts to the cloth's speed: each vertex's box covers its motion over the
