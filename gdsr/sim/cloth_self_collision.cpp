@@ -281,6 +281,7 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
   // Narrow phase (parallel; every candidate writes its own slot, so the result does not
   // depend on the thread count).
   std::vector<signed char> vt_keep(vf.size(), 0), ee_keep(ee.size(), 0), ef_cross(ef.size(), 0);
+  std::vector<float> vt_reach(vf.size()), ee_reach(ee.size());  // see VT::reach
   std::vector<std::array<float, 3>> ee_dir(ee.size());
   const int nvf = static_cast<int>(vf.size()), nee = static_cast<int>(ee.size()), nef = static_cast<int>(ef.size());
 #pragma omp parallel
@@ -299,6 +300,7 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
       double dist = 0;
       if (!project_on_triangle(p, a, b, c, bary, n, dist)) continue;
       vt_keep[k] = dist >= 0 ? 1 : -1;
+      vt_reach[k] = static_cast<float>(thickness + rel + 2 * slack);
     }
 #pragma omp for schedule(static) nowait
     for (int k = 0; k < nee; ++k) {
@@ -314,6 +316,7 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
       const double len = d.norm();
       if (len >= thickness + rel + 2 * slack) continue;
       ee_keep[k] = 1;
+      ee_reach[k] = static_cast<float>(thickness + rel + 2 * slack);
       const Vec3 u = len > 0 ? Vec3(d / len) : Vec3::Zero();
       ee_dir[k] = {static_cast<float>(u.x()), static_cast<float>(u.y()), static_cast<float>(u.z())};
     }
@@ -326,9 +329,9 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
   }
   // Kept pairs in a fixed order (the broad phase's order is not).
   for (int k = 0; k < nvf; ++k)
-    if (vt_keep[k]) vt_.push_back({vf[k].first, vf[k].second, vt_keep[k]});
+    if (vt_keep[k]) vt_.push_back({vf[k].first, vf[k].second, vt_keep[k], vt_reach[k]});
   for (int k = 0; k < nee; ++k)
-    if (ee_keep[k]) ee_.push_back({ee[k].first, ee[k].second, {ee_dir[k][0], ee_dir[k][1], ee_dir[k][2]}});
+    if (ee_keep[k]) ee_.push_back({ee[k].first, ee[k].second, {ee_dir[k][0], ee_dir[k][1], ee_dir[k][2]}, ee_reach[k]});
   std::sort(vt_.begin(), vt_.end(), [](const VT& a, const VT& b) { return a.v != b.v ? a.v < b.v : a.f < b.f; });
   vt_.erase(std::unique(vt_.begin(), vt_.end(), [](const VT& a, const VT& b) { return a.v == b.v && a.f == b.f; }),
             vt_.end());
@@ -352,7 +355,7 @@ int SelfCollision::project(Points3& x, const std::vector<double>& winv, double t
     Vec3 bary, n;
     double dist = 0;
     if (!project_on_triangle(p, a, b, cc, bary, n, dist)) continue;
-    const bool free = tangled_[c.v] || tangled_[ia] || tangled_[ib] || tangled_[ic];
+    const bool free = tangled_[c.v] || tangled_[ia] || tangled_[ib] || tangled_[ic] || -c.side * dist > c.reach;
     if (free || bary.minCoeff() < kInside) {  // crossing the plane is legal here: follow the geometry
       if (dist != 0) c.side = dist > 0 ? 1 : -1;
       continue;
@@ -377,7 +380,7 @@ int SelfCollision::project(Points3& x, const std::vector<double>& winv, double t
     const Vec3 d = (p1 + s * (q1 - p1)) - (p2 + t * (q2 - p2));
     const double len = d.norm();
     Vec3 dir(c.dir[0], c.dir[1], c.dir[2]);
-    const bool free = tangled_[i0] || tangled_[i1] || tangled_[j0] || tangled_[j1];
+    const bool free = tangled_[i0] || tangled_[i1] || tangled_[j0] || tangled_[j1] || -d.dot(dir) > c.reach;
     const bool interior = s > kEdgeEnd && s < 1 - kEdgeEnd && t > kEdgeEnd && t < 1 - kEdgeEnd;
     const double along = d.dot(dir);
     if (free || !interior || dir.squaredNorm() == 0 || (along > 0 && len >= thickness)) {

@@ -148,22 +148,14 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
       winv_[v] = 0;
     }
   } else if (!g.pinned.empty()) {
-    for (int v : g.pinned) {
+    Points3 placed(g.pinned.size(), 3);
+    for (size_t k = 0; k < g.pinned.size(); ++k) {
+      const int v = g.pinned[k];
       if (v < 0 || v >= nv) gdsr::fail("sim/cloth_solver", "pinned vertex out of range");
-      SurfaceHit hit;
-      for (double r = 0.1; hit.face < 0 && r < 5; r *= 2) {
-        grid_.build(bodyF_, body_V0, body_V0, std::max(cell, r / 2));
-        hit = grid_.closest(m.V.row(v).transpose(), body_V0, r);
-      }
-      if (hit.face < 0) gdsr::fail("sim/cloth_solver", "pinned vertex is more than 5 m from the body");
-      const Vec3 p0 = body_V0.row(bodyF_(hit.face, 0)), p1 = body_V0.row(bodyF_(hit.face, 1));
-      const Vec3 n = face_normal(body_V0, bodyF_, hit.face);
-      const Vec3 t1 = (p1 - p0).normalized(), t2 = n.cross(t1);
-      const Vec3 d = m.V.row(v).transpose() - hit.point;
-      pins_.push_back({v, hit.face, hit.bary, Vec3(d.dot(t1), d.dot(t2), d.dot(n))});
+      placed.row(static_cast<Eigen::Index>(k)) = m.V.row(v);
       winv_[v] = 0;
     }
-    grid_.build(bodyF_, body_V0, body_V0, cell);
+    pins_ = PinBinding(g.pinned, placed, F_, bodyF_, body_V0);
     place_pins(body_V0);
   }
   if (p.implicit_bending && !bends_.empty()) {
@@ -206,16 +198,8 @@ void ClothSolver::set_rest_blend(double a) {
     tethers_[c].rest = tether_rest_placed_[c] + a * (tether_rest_pattern_[c] - tether_rest_placed_[c]);
 }
 
-Vec3 ClothSolver::pin_position(const Pin& pin, const Points3& body) const {
-  const Vec3 q = bary_point(body, bodyF_, pin.face, pin.bary);
-  const Vec3 p0 = body.row(bodyF_(pin.face, 0)), p1 = body.row(bodyF_(pin.face, 1));
-  const Vec3 n = face_normal(body, bodyF_, pin.face);
-  const Vec3 t1 = (p1 - p0).normalized(), t2 = n.cross(t1);
-  return q + pin.local.x() * t1 + pin.local.y() * t2 + pin.local.z() * n;
-}
-
 void ClothSolver::place_pins(const Points3& body) {
-  for (const auto& pin : pins_) x_.row(pin.v) = pin_position(pin, body).transpose();
+  pins_.place(body, x_);
 }
 
 void ClothSolver::refresh_contacts(const Points3& body_now) {

@@ -6,7 +6,8 @@
 // sim/cloth_bending_solve.hpp), body contact with thickness and Coulomb
 // friction against the moving body (closest body triangle, refreshed every few substeps,
 // body velocity from the frame blend; where a second body part is within reach, both, the
-// part the vertex was dressed on last, see pinch_separation), pinned vertices bound to the nearest body triangle,
+// part the vertex was dressed on last, see pinch_separation), pinned bands (a waistband) moving
+// rigidly with the body under them (sim/cloth_pins.hpp),
 // inner/outer layer contact for multi-layer garments, long-range attachments to the pins
 // (sim/cloth_tethers.hpp), and cloth self-contact (see
 // sim/cloth_self_collision.hpp). Without a body, pinned vertices stay fixed in space. Sequential Gauss-Seidel in a
@@ -19,6 +20,7 @@
 #include "gdsr/io/progress.hpp"
 #include "gdsr/sim/cloth_bending_solve.hpp"
 #include "gdsr/sim/cloth_collision.hpp"
+#include "gdsr/sim/cloth_pins.hpp"
 #include "gdsr/sim/cloth_self_collision.hpp"
 #include "gdsr/sim/cloth_tethers.hpp"
 #include "gdsr/sim/garments.hpp"
@@ -106,10 +108,6 @@ class ClothSolver {
     double K[4];
     double compliance;
   };
-  struct Pin {
-    int v, face;
-    gdsr::Vec3 bary, local;
-  };
   struct Contact {
     int v, face;
     gdsr::Vec3 bary;
@@ -132,7 +130,6 @@ class ClothSolver {
   void solve_self_contacts();
   void update_velocities(double h);
   void track_self_slack();
-  gdsr::Vec3 pin_position(const Pin& pin, const gdsr::Points3& body) const;
 
   SimParams p_;
   gdsr::Faces F_, bodyF_;
@@ -144,7 +141,7 @@ class ClothSolver {
   std::vector<double> tether_rest_placed_, tether_rest_pattern_;  // m, per tether (placed: not below the pattern)
   std::vector<double> edge_scale_;  // per edge, this substep: compliance factor (1 stretched, 1/compression_ratio)
   std::vector<Bend> bends_;
-  std::vector<Pin> pins_;
+  PinBinding pins_;
   std::vector<Tether> tethers_;
   std::unique_ptr<ImplicitBending> implicit_bending_;
   std::vector<Contact> contacts_;
