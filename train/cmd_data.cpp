@@ -7,6 +7,7 @@
 #include "gdsr/geometry/correspondence.hpp"
 #include "gdsr/data/dataset.hpp"
 #include "gdsr/data/md_import.hpp"
+#include "gdsr/data/recipe.hpp"
 #include "gdsr/data/validity.hpp"
 #include "gdsr/geometry/self_intersections.hpp"
 #include "gdsr/cli/progress_bar.hpp"
@@ -14,6 +15,7 @@
 #include "gdsr/sim/cloth_solver.hpp"
 #include "gdsr/sim/garments.hpp"
 #include "gdsr/sim/sim_metrics.hpp"
+#include "train/run_log.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -64,6 +66,7 @@ struct MakeArgs {
   int rest_blend_frames = 15;
   int raster = 1024;
   int intersection_stride = kDefaultIntersectionStride;
+  std::string recipe;  // non-empty: build every clip of this recipe into out/<name>
 };
 
 double now_seconds() {
@@ -231,6 +234,82 @@ void run_make(const MakeArgs& a) {
   std::printf("  max kinetic energy: LR %.4f J, HR %.4f J\n", lr_ke, hr_ke);
   std::printf("%s", gdsr::validity_table(v).c_str());
   std::printf("  (validity figures: %.1f s)\n", validity_seconds);
+}
+
+// True when dir holds a dataset made from exactly this clip and recipe that loads cleanly
+// (every array's checksum verified); why not in `why` otherwise.
+bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why) {
+  namespace fs = std::filesystem;
+  if (!fs::exists(fs::path(dir) / "manifest.json")) {
+    why = "not built";
+    return false;
+  }
+  try {
+    const gdsr::DatasetManifest m = gdsr::read_manifest((fs::path(dir) / "manifest.json").string());
+    const auto& sp = m.sim_params;
+    auto same = [](double x, double y) { return std::abs(x - y) <= 1e-9 * std::max(1.0, std::abs(y)); };
+    if (m.garment != a.garment || m.source_motion != a.motion || !same(m.lr_particle_distance, a.lr_pd) ||
+        !same(m.hr_particle_distance, a.hr_pd) || !same(m.fps, a.fps) || m.rest_blend_frames != a.rest_blend_frames ||
+        !sp.contains("clip_start_s") || !same(sp["clip_start_s"].get<double>(), a.start) ||
+        !sp.contains("clip_seconds") || !same(sp["clip_seconds"].get<double>(), a.seconds) || m.validity.empty()) {
+      why = "built from other settings";
+      return false;
+    }
+    gdsr::load_dataset(dir);
+  } catch (const std::exception& e) {
+    why = std::string("invalid (") + e.what() + ")";
+    return false;
+  }
+  return true;
+}
+
+void run_recipe(const MakeArgs& a) {
+  namespace fs = std::filesystem;
+  const gdsr::Recipe r = gdsr::load_recipe(a.recipe, sim::garment_names());
+  if (fs::exists(fs::path(a.out) / "manifest.json") || (fs::exists(a.out) && !fs::is_directory(a.out)))
+    gdsr::fail("--out", a.out + " is a dataset or a file; a recipe builds a folder of datasets");
+  std::error_code ec;
+  fs::create_directories(a.out, ec);
+  if (ec) gdsr::fail("--out", "cannot create " + a.out + ": " + ec.message());
+  nlohmann::json splits = {{"recipe", fs::absolute(a.recipe).string()},
+                           {"train", nlohmann::json::array()},
+                           {"heldout", nlohmann::json::array()}};
+  const int n = static_cast<int>(r.clips.size());
+  int built = 0, skipped = 0;
+  for (int k = 0; k < n; ++k) {
+    const gdsr::RecipeClip& c = r.clips[k];
+    MakeArgs one = a;
+    one.recipe.clear();
+    one.garment = c.garment;
+    one.motion = c.motion;
+    one.start = c.start;
+    one.seconds = c.seconds;
+    one.lr_pd = r.lr_pd;
+    one.hr_pd = r.hr_pd;
+    one.fps = r.fps;
+    one.rest_blend_frames = r.rest_blend;
+    one.out = (fs::path(a.out) / c.name).string();
+    std::string why;
+    if (built_and_valid(one.out, one, why)) {
+      std::printf("[%d/%d] %s: built and valid, skipped\n", k + 1, n, c.name.c_str());
+      ++skipped;
+    } else {
+      std::printf("[%d/%d] %s (%s): %s on %s from %g s for %g s\n", k + 1, n, c.name.c_str(), why.c_str(),
+                  c.garment.c_str(), c.motion.c_str(), c.start, c.seconds);
+      std::fflush(stdout);
+      run_make(one);
+      ++built;
+    }
+    std::fflush(stdout);
+    splits[c.heldout ? "heldout" : "train"].push_back(c.name);
+  }
+  gdsr::write_text_atomic((fs::path(a.out) / "splits.json").string(), splits.dump(2) + "\n");
+  std::printf("recipe %s: %d built, %d already built; %zu train and %zu held-out datasets in %s (splits.json)\n",
+              a.recipe.c_str(), built, skipped, splits["train"].size(), splits["heldout"].size(), a.out.c_str());
+  std::string cmd = "gdsr train";
+  for (const auto& t : splits["train"]) cmd += " --data " + (fs::path(a.out) / t.get<std::string>()).string();
+  for (const auto& t : splits["heldout"]) cmd += " --val-data " + (fs::path(a.out) / t.get<std::string>()).string();
+  std::printf("train on it: %s --out RUN\n", cmd.c_str());
 }
 
 struct PreviewArgs {
@@ -472,7 +551,18 @@ void add_data_command(CLI::App& app) {
   make->add_option("--intersection-stride", mk->intersection_stride, "count self-intersections on every k-th frame")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  make->callback([mk]() { run_make(*mk); });
+  auto* recipe = make->add_option("--recipe", mk->recipe,
+                                  "dataset recipe (JSON: garments x clips, train / held-out split, see "
+                                  "configs/recipe_paper.json): builds each clip into --out/<name>, skipping those "
+                                  "already built and valid; an interrupted run continues where it stopped");
+  for (const char* flag : {"--garment", "--motion", "--lr-pd", "--hr-pd", "--seconds", "--start", "--fps", "--rest-blend"})
+    recipe->excludes(make->get_option(flag));
+  make->callback([mk]() {
+    if (mk->recipe.empty())
+      run_make(*mk);
+    else
+      run_recipe(*mk);
+  });
 
   auto pv = std::make_shared<PreviewArgs>();
   CLI::App* prev = data->add_subcommand("preview", "render LR and HR of one frame side by side to a PNG");

@@ -149,3 +149,41 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
     CHECK_FALSE(fs::exists(dir / "bad"));
   }
 }
+
+TEST_CASE("cli data: a recipe builds every clip once, skips what is built and valid, rebuilds what is not") {
+  const std::string bvh = "/usr/share/assimp/models/BVH/";
+  REQUIRE_MESSAGE(fs::exists(bvh + "01_03.bvh"), "assimp-testmodels is not installed (scripts/setup.sh)");
+  TempDir dir("cli_recipe");
+  std::ofstream(dir / "r.json") << R"({"lr_pd": 0.08, "hr_pd": 0.06, "rest_blend": 2, "clips": [
+    {"garment": "skirt_short", "motion": ")" + bvh + R"(01_01.bvh", "start": 1, "seconds": 0.1, "split": "train"},
+    {"garment": "skirt_short", "motion": ")" + bvh + R"(01_03.bvh", "start": 1, "seconds": 0.1, "split": "heldout",
+     "name": "unseen"}]})";
+  const std::string out = dir / "sets";
+  const std::string make = "data make --recipe '" + (dir / "r.json") + "' --settle-frames 2 --raster 64 --out '" + out + "'";
+  const Run first = gdsr_run(dir, make);
+  REQUIRE(first.status == 0);
+  CHECK(first.out.find("2 built, 0 already built") != std::string::npos);
+  CHECK(fs::exists(out + "/skirt_short_01_01_1s/manifest.json"));
+  CHECK(fs::exists(out + "/unseen/manifest.json"));
+  const std::string splits = gdsr_test::slurp(out + "/splits.json");
+  CHECK(splits.find("\"heldout\": [\n    \"unseen\"") != std::string::npos);
+  CHECK(first.out.find("--val-data " + out + "/unseen") != std::string::npos);
+
+  const auto stamp = fs::last_write_time(out + "/unseen/hr_frames.bin");
+  const Run again = gdsr_run(dir, make);
+  REQUIRE(again.status == 0);
+  CHECK(again.out.find("0 built, 2 already built") != std::string::npos);
+  CHECK(fs::last_write_time(out + "/unseen/hr_frames.bin") == stamp);
+
+  // A damaged dataset (a truncated array) is rebuilt; the intact one is kept.
+  fs::resize_file(out + "/unseen/hr_frames.bin", 100);
+  const Run repair = gdsr_run(dir, make);
+  REQUIRE(repair.status == 0);
+  CHECK(repair.out.find("unseen (invalid") != std::string::npos);
+  CHECK(repair.out.find("1 built, 1 already built") != std::string::npos);
+  CHECK(gdsr_run(dir, "data check --data '" + out + "/unseen'").status == 0);
+
+  check_one_line_error(gdsr_run(dir, make + " --garment pants"), "--recipe");
+  check_one_line_error(gdsr_run(dir, "data make --recipe '" + (dir / "none.json") + "' --out '" + out + "'"),
+                       "none.json");
+}
