@@ -28,6 +28,35 @@ double radial_extent(const gdsr::TriMesh& b, const Vec3& axis, double y0, double
   return r;
 }
 
+// Radial profile of the section of b at height y around the axis: for each direction
+// psi_k = 2 pi k / bins, the farthest crossing (below max_r) of the ray from the axis with the
+// triangles' intersection segments with the plane y; -1 where the ray meets nothing.
+std::vector<double> section_profile(const gdsr::TriMesh& b, const Vec3& axis, double y, double max_r, int bins) {
+  std::vector<double> r(bins, -1.0);
+  constexpr double kTwoPi = 6.283185307179586;
+  for (int f = 0; f < b.F.rows(); ++f) {
+    Eigen::Vector2d pts[2];
+    int n = 0;
+    for (int k = 0; k < 3 && n < 2; ++k) {
+      const Vec3 p = b.V.row(b.F(f, k)), q = b.V.row(b.F(f, (k + 1) % 3));
+      if ((p.y() - y) * (q.y() - y) > 0 || p.y() == q.y()) continue;
+      const Vec3 x = p + (q - p) * ((y - p.y()) / (q.y() - p.y()));
+      pts[n++] = Eigen::Vector2d(x.z() - axis.z(), x.x() - axis.x());  // (front, side): psi = atan2(side, front)
+    }
+    if (n < 2) continue;
+    for (int k = 0; k < bins; ++k) {
+      const Eigen::Vector2d d(std::cos(kTwoPi * k / bins), std::sin(kTwoPi * k / bins));
+      const Eigen::Vector2d e = pts[1] - pts[0];
+      const double den = d.x() * e.y() - d.y() * e.x();
+      if (std::abs(den) < 1e-15) continue;
+      const double t = (pts[0].x() * e.y() - pts[0].y() * e.x()) / den;           // along the ray
+      const double u = (pts[0].x() * d.y() - pts[0].y() * d.x()) / den;           // along the segment
+      if (u >= 0 && u <= 1 && t > 0 && t < max_r) r[k] = std::max(r[k], t);
+    }
+  }
+  return r;
+}
+
 // Centre (bounding-box middle in x and z) of the vertices on side `side` (+1: x > axis.x)
 // within `slab` of height y and closer than max_dx to the axis in x; false if none.
 bool leg_centre(const gdsr::TriMesh& b, const Vec3& axis, int side, double y, double slab, Vec3& c,
@@ -226,6 +255,10 @@ BodyLandmarks measure_body(const gdsr::TriMesh& b) {
     }
   }
   lm.chest_r = std::max(radial_extent(b, lm.axis, lm.floor + 0.70 * H, slab, 0.24 * s), lm.waist_r);
+  // The waist section from the axis: directions that meet nothing (a hole in a scan) take the
+  // widest extent, so a garment fitted to it never goes inside the body.
+  lm.waist_profile = section_profile(b, lm.axis, lm.waist_y, max_r, BodyLandmarks::kWaistBins);
+  for (double& r : lm.waist_profile) r = r > 0 ? std::min(r, lm.waist_r) : lm.waist_r;
   lm.shoulder_halfwidth = 0.19 * s;
   // Legs: vertices right of the axis at thigh height.
   double sx = 0;
@@ -245,6 +278,16 @@ BodyLandmarks measure_body(const gdsr::TriMesh& b) {
   measure_arms(b, lm);
   measure_upper_trunk(b, lm);
   return lm;
+}
+
+double waist_radius(const BodyLandmarks& lm, double psi) {
+  if (lm.waist_profile.empty()) return lm.waist_r;
+  const int n = static_cast<int>(lm.waist_profile.size());
+  double t = psi / 6.283185307179586 * n;
+  t -= n * std::floor(t / n);
+  const int i = static_cast<int>(t) % n;
+  const double a = t - std::floor(t);
+  return (1 - a) * lm.waist_profile[i] + a * lm.waist_profile[(i + 1) % n];
 }
 
 }  // namespace sim

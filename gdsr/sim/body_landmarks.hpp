@@ -6,6 +6,8 @@
 
 #include "gdsr/geometry/mesh.hpp"
 
+#include <vector>
+
 namespace sim {
 
 struct BodyLandmarks {
@@ -15,6 +17,11 @@ struct BodyLandmarks {
   double waist_r = 0, hip_r = 0;  // max horizontal distance of the trunk from the axis
   double chest_r = 0, shoulder_halfwidth = 0, leg_x = 0, thigh_r = 0;
   double bust_r = 0;  // max horizontal distance of the trunk from the axis between waist and armpits
+  // The trunk's section at waist_y seen from the axis: its distance from the axis in direction
+  // psi = atan2(x - axis.x, z - axis.z) (0 = the body's front), at kWaistBins directions
+  // psi_k = 2 pi k / kWaistBins. Never above waist_r.
+  static constexpr int kWaistBins = 72;
+  std::vector<double> waist_profile;
   // Bounding box of the trunk between hips and armpits (points within 0.26 m x H / 1.75 of the axis).
   gdsr::Vec3 trunk_lo = gdsr::Vec3::Zero(), trunk_hi = gdsr::Vec3::Zero();
   // Top of the shoulders between neck and shoulder joints, and the bounding box of the neck
@@ -36,6 +43,10 @@ struct BodyLandmarks {
   gdsr::Vec3 arm_dir[2] = {gdsr::Vec3::UnitX(), -gdsr::Vec3::UnitX()};
   double arm_len[2] = {0, 0}, arm_r[2] = {0, 0};
 };
+
+// Distance of the trunk's waist section from the axis in direction psi (radians, see
+// waist_profile), interpolated between the measured directions.
+double waist_radius(const BodyLandmarks& lm, double psi);
 
 // Half extents of the trunk along x (|x - axis.x|) and z (|z - axis.z|) over the body's
 // vertices with y0 <= y <= y1 and horizontal distance from the axis below max_r (metres).
