@@ -620,6 +620,35 @@ std::vector<OpRows> table() {
   // The planes hold weights (~s) and biases (~s^2) side by side: each column is judged at its
   // own scale (one step of 1e-6 s^2 would make a weight entry s^2 and overflow at huge).
   t.back().opt.per_column = true;
+  // Complex add / sub broadcast like the real ones, on both parts at once.
+  auto cplx_bcast = [](const std::vector<LIn>& a, LD sign) {
+    const std::vector<LD> re = bcast(a[0], a[2], [sign](LD p, LD q) { return p + sign * q; });
+    const std::vector<LD> im = bcast(a[1], a[3], [sign](LD p, LD q) { return p + sign * q; });
+    std::vector<CLD> z;
+    for (size_t i = 0; i < re.size(); ++i) z.emplace_back(re[i], im[i]);
+    return split_ref(z, 4, 3);
+  };
+  t.push_back(op(
+      "complex add (row broadcast)",
+      [](const auto& x) { return split_t(ag::add(ag::complex_from(x[0], x[1]), ag::complex_from(x[2], x[3]))); },
+      scaled({u43, v43, randn({1, 3}, 138), randn({1, 3}, 139)}),
+      [cplx_bcast](const std::vector<LIn>& a) { return cplx_bcast(a, 1); }, lin));
+  t.push_back(op(
+      "complex sub (col broadcast)",
+      [](const auto& x) { return split_t(ag::sub(ag::complex_from(x[0], x[1]), ag::complex_from(x[2], x[3]))); },
+      scaled({u43, v43, randn({4, 1}, 140), randn({4, 1}, 141)}),
+      [cplx_bcast](const std::vector<LIn>& a) { return cplx_bcast(a, -1); }, lin));
+  // x (real) times w = p + i q: x p + i x q, a product of two scaled inputs.
+  t.push_back(op(
+      "complex_from_real",
+      [](const auto& x) { return split_t(ag::mul(ag::complex_from_real(x[0]), ag::complex_from(x[1], x[2]))); },
+      scaled({u43, rand_signed({4, 3}, 142, 0.2, 1), rand_signed({4, 3}, 143, 0.2, 1)}),
+      [](const std::vector<LIn>& a) {
+        std::vector<CLD> z;
+        for (size_t i = 0; i < a[0].v.size(); ++i) z.push_back(a[0].v[i] * CLD(a[1].v[i], a[2].v[i]));
+        return split_ref(z, 4, 3);
+      },
+      bil));
   t.push_back(op(
       "conv2d_3x3", [](const auto& x) { return ag::conv2d_3x3(x[0], x[1], x[2]); },
       scaled({randn({1, 2, 5, 4}, 130), randn({3, 2, 3, 3}, 131), randn({1, 3}, 132)}, {1, 1, 2}),
