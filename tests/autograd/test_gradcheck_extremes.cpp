@@ -8,7 +8,9 @@
 //  - the float64 gradient: central differences within the suite's 1e-6 (Grad::central), or,
 //    where central differences cannot be formed (the op's period is below the spacing of the
 //    doubles, the value is inf, the inputs are subnormal, or an offset hides them), the
-//    analytic gradient against its closed form (Grad::closed).
+//    analytic gradient against its closed form (Grad::closed), or, on the subnormal rows of
+//    ops whose gradient is scale-free there, against the op's own at its "tiny" row
+//    (Grad::like_tiny).
 // Where the exact value or gradient lies beyond the largest float, the op must give inf of the
 // right sign, as its header documents (rows marked inf_ok, with the reason).
 // The coverage test fails if a suite op has no row here.
@@ -17,6 +19,7 @@
 #include "autograd/gradcheck_suite.hpp"
 #include "tests/support/ag_test_util.hpp"
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <complex>
@@ -42,7 +45,9 @@ using F64 = std::function<Tensord(const std::vector<Tensord>&)>;
 using F32 = std::function<Tensorf(const std::vector<Tensorf>&)>;
 using Inputs = std::function<std::vector<Tensord>(double)>;
 
-enum class Grad { central, closed };
+// like_tiny: the analytic gradient equals the op's own at its "tiny" row (itself checked),
+// for ops whose gradient is constant to rounding below that scale (subnormal rows).
+enum class Grad { central, closed, like_tiny };
 
 struct Scale {
   std::string label;
@@ -691,6 +696,43 @@ std::vector<OpRows> table() {
   t.push_back(op(
       "max_pool2x2", [](const auto& x) { return ag::max_pool2x2(x[0]); }, scaled({img}),
       [pool_ref](const std::vector<LIn>& a) { return pool_ref(a[0], true); }, lin));
+
+  // Subnormal inputs (1e-310, float32 1e-40) for the ops whose gradient no longer depends on
+  // the scale below "tiny" (linear and piecewise-linear ops, and the smooth ones that are
+  // linear near 0, the norms in their eps-dominated regime): the value against the reference
+  // and the gradient against the op's own at "tiny". Central differences cannot be formed on
+  // subnormals (they carry ~13 digits). Left out: products of two inputs (they underflow to
+  // an exact 0), and ops whose gradient grows as 1 / x (log, div, atan2: inf there, as their
+  // headers say) or vanishes with x (cos, pow).
+  const std::set<std::string> kSubnormal = {"add (row broadcast)",
+                                            "sub (col broadcast)",
+                                            "sin",
+                                            "tanh",
+                                            "abs",
+                                            "relu",
+                                            "leaky_relu",
+                                            "sigmoid",
+                                            "clamp",
+                                            "transpose",
+                                            "sum_rows / mean_cols",
+                                            "concat / slice",
+                                            "index_select_rows",
+                                            "scatter_add_rows",
+                                            "scatter_mean_rows",
+                                            "normalize_rows",
+                                            "channel_norm",
+                                            "layer_norm",
+                                            "l1_loss",
+                                            "wire",
+                                            "neg / mul_scalar / add_scalar",
+                                            "sum / mean / mean_rows / sum_cols",
+                                            "concat_rows / slice_rows / reshape",
+                                            "complex add (row broadcast)",
+                                            "complex sub (col broadcast)",
+                                            "avg_pool2x2",
+                                            "max_pool2x2"};
+  for (OpRows& o : t)
+    if (kSubnormal.count(o.op)) o.scales.push_back({"subnormal", 1e-310, 1e-40, Grad::like_tiny});
   return t;
 }
 
@@ -753,6 +795,23 @@ void run_row(const OpRows& o, const Scale& sc) {
     const ag::GradCheckResult r = ag::gradcheck(o.f, in, opt);
     CHECK(r.checked > 0);
     CHECK_MESSAGE(r.max_rel_error < 1e-6, what << ": " << r.report());
+  } else if (sc.grad == Grad::like_tiny) {
+    auto grads = [&](const Scale& at) {
+      std::vector<Tensord> x = (at.inputs ? at.inputs : o.inputs)(at.s);
+      for (Tensord& xi : x) xi.set_requires_grad(true);
+      ag::sum(o.f(x)).backward();
+      return x;
+    };
+    const auto tiny = std::find_if(o.scales.begin(), o.scales.end(), [](const Scale& x) { return x.label == "tiny"; });
+    REQUIRE(tiny != o.scales.end());
+    const std::vector<Tensord> here = grads(sc), ref = grads(*tiny);
+    for (size_t k = 0; k < here.size(); ++k) {
+      REQUIRE(here[k].has_grad());
+      REQUIRE(ref[k].has_grad());
+      const std::vector<LD> r(ref[k].grad().begin(), ref[k].grad().end());
+      check_against(what + " (gradient of input " + std::to_string(k) + " against tiny)", here[k].grad().data(), r,
+                    1e-12, false);
+    }
   } else {
     REQUIRE(o.dref);
     for (Tensord& x : in) x.set_requires_grad(true);
