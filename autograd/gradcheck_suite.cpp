@@ -110,6 +110,16 @@ std::vector<Case> cases() {
                  return split(grouped_linear_planes(complex_from(x[0], x[1]), x[2], x[3], 1, 7, {0, 0, 1, 1}, 2));
                },
                {{4, 3}, {4, 3}, {2, 10}, {2, 10}}});
+  c.push_back({"complex add (row broadcast)",
+               [](V x) { return split(add(complex_from(x[0], x[1]), complex_from(x[2], x[3]))); },
+               {{4, 3}, {4, 3}, {1, 3}, {1, 3}}});
+  c.push_back({"complex sub (col broadcast)",
+               [](V x) { return split(sub(complex_from(x[0], x[1]), complex_from(x[2], x[3]))); },
+               {{4, 3}, {4, 3}, {4, 1}, {4, 1}}});
+  // Times a complex w, so both parts of the upstream gradient reach complex_from_real.
+  c.push_back({"complex_from_real",
+               [](V x) { return split(mul(complex_from_real(x[0]), complex_from(x[1], x[2]))); },
+               {{4, 3}, {4, 3}, {4, 3}}});
   c.push_back({"conv2d_3x3", [](V x) { return conv2d_3x3(x[0], x[1], x[2]); }, {{1, 2, 5, 4}, {3, 2, 3, 3}, {1, 3}}});
   c.push_back({"avg_pool2x2", [](V x) { return avg_pool2x2(x[0]); }, {{1, 2, 4, 6}}});
   c.push_back({"max_pool2x2", [](V x) { return max_pool2x2(x[0]); }, {{1, 2, 4, 6}}});

@@ -66,7 +66,8 @@ template <class R> Tensor<R> imag(const Tensor<std::complex<R>>& z) {
   return out;
 }
 
-// |z| = hypot(a, b); dL/da + i dL/db = g z / |z| (0 at z = 0).
+// |z| = hypot(a, b); dL/da + i dL/db = g z / |z| (0 at z = 0), formed as g (z / |z|): the unit
+// z / |z| is exact for every finite z, where g / |z| overflows once |z| is subnormal.
 template <class R> Tensor<R> modulus(const Tensor<std::complex<R>>& z) {
   auto out = new_output<R>(z.shape());
   const int64_t n = z.numel();
@@ -83,7 +84,7 @@ template <class R> Tensor<R> modulus(const Tensor<std::complex<R>>& z) {
     std::complex<R>* gz = zn->grad.data();
 #pragma omp parallel for if (n > kParallelMin)
     for (int64_t i = 0; i < n; ++i)
-      if (m[i] > 0) gz[i] += (g[i] / m[i]) * pz[i];
+      if (m[i] > 0) gz[i] += g[i] * (pz[i] / m[i]);
   });
   return out;
 }

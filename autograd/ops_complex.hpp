@@ -13,6 +13,8 @@ template <class R> Tensor<std::complex<R>> complex_from(const Tensor<R>& re, con
 template <class R> Tensor<std::complex<R>> complex_from_real(const Tensor<R>& re);  // im = 0
 template <class R> Tensor<R> real(const Tensor<std::complex<R>>& z);
 template <class R> Tensor<R> imag(const Tensor<std::complex<R>>& z);
-template <class R> Tensor<R> modulus(const Tensor<std::complex<R>>& z);  // |z|, grad 0 at z = 0
+// |z| (hypot: no overflow or underflow of |z|^2); gradient z / |z|, exact for every finite z
+// from subnormal to near-overflow moduli, and 0 at z = 0.
+template <class R> Tensor<R> modulus(const Tensor<std::complex<R>>& z);
 
 }  // namespace ag

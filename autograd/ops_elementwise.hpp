@@ -13,7 +13,9 @@ template <class T> Tensor<T> add(const Tensor<T>& a, const Tensor<T>& b);
 template <class T> Tensor<T> sub(const Tensor<T>& a, const Tensor<T>& b);
 template <class T> Tensor<T> mul(const Tensor<T>& a, const Tensor<T>& b);
 // div needs b != 0: b = 0 gives inf (NaN for 0 / 0) and so do its gradients 1 / b and
-// -a / b^2, the latter already once |a| / b^2 exceeds the largest float.
+// -a / b^2, the latter already once |a| / b^2 exceeds the largest float. Complex: the same
+// limits on |b|, and where a result's modulus exceeds the largest float its parts are inf or
+// NaN (e.g. the gradient at subnormal |b|).
 template <class T> Tensor<T> div(const Tensor<T>& a, const Tensor<T>& b);
 template <class T> Tensor<T> neg(const Tensor<T>& a);
 template <class T> Tensor<T> add_scalar(const Tensor<T>& a, T s);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace nn {
 
@@ -31,10 +32,22 @@ template <class R> RealView<R> view(typename AdamW<R>::Slot& s) {
 }
 }  // namespace
 
+void check_adamw_options(const AdamWOptions& o) {
+  auto refuse = [](const char* key, const char* range, double v) {
+    throw ag::Error(std::string("AdamW: ") + key + " must be " + range + ", got " + std::to_string(v));
+  };
+  if (!std::isfinite(o.lr) || o.lr < 0) refuse("lr", "finite and >= 0", o.lr);
+  if (!(o.beta1 >= 0 && o.beta1 < 1)) refuse("beta1", "in [0, 1)", o.beta1);
+  if (!(o.beta2 >= 0 && o.beta2 < 1)) refuse("beta2", "in [0, 1)", o.beta2);
+  if (!std::isfinite(o.eps) || o.eps <= 0) refuse("eps", "finite and > 0", o.eps);
+  if (!std::isfinite(o.weight_decay) || o.weight_decay < 0) refuse("weight_decay", "finite and >= 0", o.weight_decay);
+}
+
 template <class R> int64_t AdamW<R>::Slot::reals() const { return (complex ? 2 : 1) * node->numel(); }
 
 template <class R> AdamW<R>::AdamW(const std::vector<std::pair<std::string, ag::Tensor<R>>>& params, AdamWOptions opt)
     : opt_(opt) {
+  check_adamw_options(opt_);
   add_all(params);
 }
 

@@ -32,6 +32,12 @@ struct AdamWOptions {
   bool amsgrad = false;
 };
 
+// Refuses (ag::Error naming the option) what the update cannot take: lr not finite or < 0,
+// beta1 or beta2 outside [0, 1) (at 1 the bias correction 1 - beta^t is 0), eps not finite or
+// <= 0 (at 0 an entry whose gradient and moments are 0 becomes 0 / 0 = NaN), weight_decay not
+// finite or < 0.
+void check_adamw_options(const AdamWOptions& o);
+
 // R: float or double. Holds handles to the parameters (real ones and complex<R> ones).
 template <class R> class AdamW {
  public:
@@ -44,7 +50,7 @@ template <class R> class AdamW {
     int64_t reals() const;      // number of real values in the parameter
   };
 
-  explicit AdamW(AdamWOptions opt = {}) : opt_(opt) {}
+  explicit AdamW(AdamWOptions opt = {}) : opt_(opt) { check_adamw_options(opt_); }
   AdamW(const std::vector<std::pair<std::string, ag::Tensor<R>>>& params, AdamWOptions opt = {});
 
   void add(const std::string& name, const ag::Tensor<R>& p);
@@ -59,7 +65,12 @@ template <class R> class AdamW {
   void zero_grad();
 
   double lr() const { return opt_.lr; }
-  void set_lr(double lr) { opt_.lr = lr; }
+  void set_lr(double lr) {
+    AdamWOptions o = opt_;
+    o.lr = lr;
+    check_adamw_options(o);
+    opt_.lr = lr;
+  }
   const AdamWOptions& options() const { return opt_; }
   int64_t steps_taken() const { return steps_; }  // calls to step()
   void set_steps_taken(int64_t s) { steps_ = s; }

@@ -315,8 +315,18 @@ template <class T> Checkpoint load_checkpoint(const std::string& path, Module<T>
   for (const auto& e : ck.entries)
     if (e.name.rfind("param/", 0) == 0 && !expected.count(e.name))
       throw ag::Error(where + "parameter '" + e.name.substr(6) + "' is not in the model");
+  std::vector<double> options;  // lr, beta1, beta2, eps, weight_decay, amsgrad
   if (opt) {
     if (!ck.find("adamw/#options")) throw ag::Error(where + "holds no optimizer state");
+    options = ck.read<double>("adamw/#options");
+    if (options.empty()) throw ag::Error(where + "the optimizer options are empty");
+    AdamWOptions with_lr = opt->options();
+    with_lr.lr = options[0];
+    try {
+      check_adamw_options(with_lr);
+    } catch (const ag::Error& e) {
+      throw ag::Error(where + e.what());
+    }
     std::set<std::string> slots;
     for (const auto& s : opt->slots()) {
       slots.insert(s.name);
@@ -338,8 +348,7 @@ template <class T> Checkpoint load_checkpoint(const std::string& path, Module<T>
   }
   for (auto& [name, t] : params) ck.read_into("param/" + name, t);
   if (opt) {
-    const auto o = ck.read<double>("adamw/#options");
-    opt->set_lr(o.at(0));
+    opt->set_lr(options[0]);
     opt->set_steps_taken(ck.read<int64_t>("adamw/#steps").at(0));
     for (auto& s : opt->slots()) {
       const std::string p = "adamw/" + s.name + "/";

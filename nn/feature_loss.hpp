@@ -15,7 +15,10 @@ enum class FeatureLossKind {
 
 // a, b [N x C x H x W] -> [1 x 1]: 1 - mean over the N*H*W pixels of the cosine similarity
 // of the C-vectors, cos = a.b / (max(|a|, eps) max(|b|, eps)) (torch.nn.functional.
-// cosine_similarity). Gradients to a and b (either may be constant).
+// cosine_similarity). Gradients to a and b (either may be constant). Valid for all finite
+// entries: each pixel's vectors are scaled by their largest |entry| first, so entries from
+// subnormal to near the largest float give the exact cosine (a plain a.a overflows in float32
+// beyond ~1e19). eps must be finite and > 0 (ag::Error otherwise), in the units of a and b.
 template <class T>
 ag::Tensor<T> cosine_distance_channels(const ag::Tensor<T>& a, const ag::Tensor<T>& b, T eps = T(1e-8));
 

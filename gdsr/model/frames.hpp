@@ -1,6 +1,8 @@
 // Differentiable geometry used by the GDSR network itself (features, E, A): local triangle
 // frames, local -> world mapping and vertex normals, built from autograd ops on a position
-// tensor X [V x 3] (metres) so gradients reach positions and parameters.
+// tensor X [V x 3] (metres) so gradients reach positions and parameters. Valid range as
+// geometry_ad.hpp's: edge lengths between ~1e-150 and ~1e150 (float32: 1e-19 and 1e19), where
+// squared lengths and cross products stay normal floats; tested from 1e-5 to 1e3.
 #pragma once
 
 #include "autograd/tensor.hpp"

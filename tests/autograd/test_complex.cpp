@@ -1,6 +1,10 @@
 // Gradient checks of complex_from, real, imag and modulus.
 #include "tests/support/ag_test_util.hpp"
 
+#include <complex>
+#include <limits>
+#include <vector>
+
 using namespace agt;
 using ag::Tensorcd;
 
@@ -23,9 +27,8 @@ TEST_CASE("complex: from / real / imag / modulus gradients") {
              {re, im});
   for (double s : {1e-3, 1e3}) {
     INFO("scale " << s);
-    check_grad(
-        "modulus scaled", kTol, [](auto& in) { return ag::modulus(cplx(in[0], in[1])); },
-        {randn({4, 3}, 3, s), randn({4, 3}, 4, s)});
+    check_grad("modulus scaled", kTol, [](auto& in) { return ag::modulus(cplx(in[0], in[1])); },
+               {randn({4, 3}, 3, s), randn({4, 3}, 4, s)});
   }
 }
 
@@ -50,4 +53,30 @@ TEST_CASE("complex: float32 matches float64 within 1e-5") {
   const auto zf = ag::complex_from(to_float(re), to_float(im));
   CHECK(max_abs_diff(ag::modulus(zf * zf), ag::modulus(zd * zd)) < 1e-5);
   CHECK(max_abs_diff(ag::imag(zf * zf), ag::imag(zd * zd)) < 1e-5);
+}
+
+TEST_CASE("complex: modulus gradient is the unit z / |z| at subnormal and near-overflow moduli") {
+  // g / |z| overflows once |z| is subnormal (1 / 3e-310 > the largest double), which made the
+  // gradient inf or NaN where the exact value is a unit complex number.
+  auto run = [](auto zero, double s) {
+    using R = decltype(zero);
+    using C = std::complex<R>;
+    CAPTURE(s);
+    const Tensord re = rand_signed({3, 4}, 41, 0.2, 1), im = randn({3, 4}, 42);
+    std::vector<C> v;
+    for (size_t i = 0; i < re.values().size(); ++i) v.emplace_back(R(re.values()[i] * s), R(im.values()[i] * s));
+    ag::Tensor<C> z = ag::Tensor<C>::from({3, 4}, v, true);
+    ag::sum(ag::modulus(z)).backward();
+    for (size_t i = 0; i < v.size(); ++i) {
+      CAPTURE(i);
+      const long double a = v[i].real(), b = v[i].imag(), m = std::sqrt(a * a + b * b);
+      // A few rounding units, plus the rounding of a subnormal |z| itself (spacing
+      // denorm_min, relative denorm_min / |z|: 1.6e-14 at 3e-310).
+      const double tol = 4 * std::numeric_limits<R>::epsilon() + 2 * double(std::numeric_limits<R>::denorm_min() / m);
+      CHECK(std::abs(double(z.grad()[i].real() - a / m)) < tol);
+      CHECK(std::abs(double(z.grad()[i].imag() - b / m)) < tol);
+    }
+  };
+  for (double s : {3e-310, 1e-300, 1.0, 1e307}) run(0.0, s);
+  for (double s : {3e-40, 1e-30, 1.0, 1e37}) run(0.0f, s);
 }

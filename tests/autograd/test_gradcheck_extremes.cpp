@@ -8,7 +8,9 @@
 //  - the float64 gradient: central differences within the suite's 1e-6 (Grad::central), or,
 //    where central differences cannot be formed (the op's period is below the spacing of the
 //    doubles, the value is inf, the inputs are subnormal, or an offset hides them), the
-//    analytic gradient against its closed form (Grad::closed).
+//    analytic gradient against its closed form (Grad::closed), or, on the subnormal rows of
+//    ops whose gradient is scale-free there, against the op's own at its "tiny" row
+//    (Grad::like_tiny).
 // Where the exact value or gradient lies beyond the largest float, the op must give inf of the
 // right sign, as its header documents (rows marked inf_ok, with the reason).
 // The coverage test fails if a suite op has no row here.
@@ -17,6 +19,7 @@
 #include "autograd/gradcheck_suite.hpp"
 #include "tests/support/ag_test_util.hpp"
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <complex>
@@ -42,7 +45,9 @@ using F64 = std::function<Tensord(const std::vector<Tensord>&)>;
 using F32 = std::function<Tensorf(const std::vector<Tensorf>&)>;
 using Inputs = std::function<std::vector<Tensord>(double)>;
 
-enum class Grad { central, closed };
+// like_tiny: the analytic gradient equals the op's own at its "tiny" row (itself checked),
+// for ops whose gradient is constant to rounding below that scale (subnormal rows).
+enum class Grad { central, closed, like_tiny };
 
 struct Scale {
   std::string label;
@@ -620,6 +625,35 @@ std::vector<OpRows> table() {
   // The planes hold weights (~s) and biases (~s^2) side by side: each column is judged at its
   // own scale (one step of 1e-6 s^2 would make a weight entry s^2 and overflow at huge).
   t.back().opt.per_column = true;
+  // Complex add / sub broadcast like the real ones, on both parts at once.
+  auto cplx_bcast = [](const std::vector<LIn>& a, LD sign) {
+    const std::vector<LD> re = bcast(a[0], a[2], [sign](LD p, LD q) { return p + sign * q; });
+    const std::vector<LD> im = bcast(a[1], a[3], [sign](LD p, LD q) { return p + sign * q; });
+    std::vector<CLD> z;
+    for (size_t i = 0; i < re.size(); ++i) z.emplace_back(re[i], im[i]);
+    return split_ref(z, 4, 3);
+  };
+  t.push_back(op(
+      "complex add (row broadcast)",
+      [](const auto& x) { return split_t(ag::add(ag::complex_from(x[0], x[1]), ag::complex_from(x[2], x[3]))); },
+      scaled({u43, v43, randn({1, 3}, 138), randn({1, 3}, 139)}),
+      [cplx_bcast](const std::vector<LIn>& a) { return cplx_bcast(a, 1); }, lin));
+  t.push_back(op(
+      "complex sub (col broadcast)",
+      [](const auto& x) { return split_t(ag::sub(ag::complex_from(x[0], x[1]), ag::complex_from(x[2], x[3]))); },
+      scaled({u43, v43, randn({4, 1}, 140), randn({4, 1}, 141)}),
+      [cplx_bcast](const std::vector<LIn>& a) { return cplx_bcast(a, -1); }, lin));
+  // x (real) times w = p + i q: x p + i x q, a product of two scaled inputs.
+  t.push_back(op(
+      "complex_from_real",
+      [](const auto& x) { return split_t(ag::mul(ag::complex_from_real(x[0]), ag::complex_from(x[1], x[2]))); },
+      scaled({u43, rand_signed({4, 3}, 142, 0.2, 1), rand_signed({4, 3}, 143, 0.2, 1)}),
+      [](const std::vector<LIn>& a) {
+        std::vector<CLD> z;
+        for (size_t i = 0; i < a[0].v.size(); ++i) z.push_back(a[0].v[i] * CLD(a[1].v[i], a[2].v[i]));
+        return split_ref(z, 4, 3);
+      },
+      bil));
   t.push_back(op(
       "conv2d_3x3", [](const auto& x) { return ag::conv2d_3x3(x[0], x[1], x[2]); },
       scaled({randn({1, 2, 5, 4}, 130), randn({3, 2, 3, 3}, 131), randn({1, 3}, 132)}, {1, 1, 2}),
@@ -662,6 +696,43 @@ std::vector<OpRows> table() {
   t.push_back(op(
       "max_pool2x2", [](const auto& x) { return ag::max_pool2x2(x[0]); }, scaled({img}),
       [pool_ref](const std::vector<LIn>& a) { return pool_ref(a[0], true); }, lin));
+
+  // Subnormal inputs (1e-310, float32 1e-40) for the ops whose gradient no longer depends on
+  // the scale below "tiny" (linear and piecewise-linear ops, and the smooth ones that are
+  // linear near 0, the norms in their eps-dominated regime): the value against the reference
+  // and the gradient against the op's own at "tiny". Central differences cannot be formed on
+  // subnormals (they carry ~13 digits). Left out: products of two inputs (they underflow to
+  // an exact 0), and ops whose gradient grows as 1 / x (log, div, atan2: inf there, as their
+  // headers say) or vanishes with x (cos, pow).
+  const std::set<std::string> kSubnormal = {"add (row broadcast)",
+                                            "sub (col broadcast)",
+                                            "sin",
+                                            "tanh",
+                                            "abs",
+                                            "relu",
+                                            "leaky_relu",
+                                            "sigmoid",
+                                            "clamp",
+                                            "transpose",
+                                            "sum_rows / mean_cols",
+                                            "concat / slice",
+                                            "index_select_rows",
+                                            "scatter_add_rows",
+                                            "scatter_mean_rows",
+                                            "normalize_rows",
+                                            "channel_norm",
+                                            "layer_norm",
+                                            "l1_loss",
+                                            "wire",
+                                            "neg / mul_scalar / add_scalar",
+                                            "sum / mean / mean_rows / sum_cols",
+                                            "concat_rows / slice_rows / reshape",
+                                            "complex add (row broadcast)",
+                                            "complex sub (col broadcast)",
+                                            "avg_pool2x2",
+                                            "max_pool2x2"};
+  for (OpRows& o : t)
+    if (kSubnormal.count(o.op)) o.scales.push_back({"subnormal", 1e-310, 1e-40, Grad::like_tiny});
   return t;
 }
 
@@ -724,6 +795,23 @@ void run_row(const OpRows& o, const Scale& sc) {
     const ag::GradCheckResult r = ag::gradcheck(o.f, in, opt);
     CHECK(r.checked > 0);
     CHECK_MESSAGE(r.max_rel_error < 1e-6, what << ": " << r.report());
+  } else if (sc.grad == Grad::like_tiny) {
+    auto grads = [&](const Scale& at) {
+      std::vector<Tensord> x = (at.inputs ? at.inputs : o.inputs)(at.s);
+      for (Tensord& xi : x) xi.set_requires_grad(true);
+      ag::sum(o.f(x)).backward();
+      return x;
+    };
+    const auto tiny = std::find_if(o.scales.begin(), o.scales.end(), [](const Scale& x) { return x.label == "tiny"; });
+    REQUIRE(tiny != o.scales.end());
+    const std::vector<Tensord> here = grads(sc), ref = grads(*tiny);
+    for (size_t k = 0; k < here.size(); ++k) {
+      REQUIRE(here[k].has_grad());
+      REQUIRE(ref[k].has_grad());
+      const std::vector<LD> r(ref[k].grad().begin(), ref[k].grad().end());
+      check_against(what + " (gradient of input " + std::to_string(k) + " against tiny)", here[k].grad().data(), r,
+                    1e-12, false);
+    }
   } else {
     REQUIRE(o.dref);
     for (Tensord& x : in) x.set_requires_grad(true);

@@ -6,6 +6,11 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace {
 // Loss at step t: s_t * sum_i c_i p_i^2 (gradient 2 s_t c_i p_i); s_t shrinks so that v
@@ -119,6 +124,39 @@ TEST_CASE("AdamW: parameters without a gradient are skipped / complex parameters
   CHECK(opt.slots()[0].step == 3);
   CHECK(z.values()[0].real() == doctest::Approx(re.values()[0]).epsilon(1e-14));
   CHECK(z.values()[0].imag() == doctest::Approx(re.values()[1]).epsilon(1e-14));
+}
+
+TEST_CASE("AdamW: options outside the domain of the update are refused naming the option") {
+  // eps = 0 would turn an entry whose gradient and moments are 0 into 0 / 0 = NaN; beta = 1
+  // makes the bias correction 1 - beta^t zero.
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const std::vector<std::pair<std::function<void(nn::AdamWOptions&)>, std::string>> bad = {
+      {[](auto& o) { o.eps = 0; }, "eps"},          {[](auto& o) { o.eps = -1e-8; }, "eps"},
+      {[nan](auto& o) { o.eps = nan; }, "eps"},     {[](auto& o) { o.beta1 = 1; }, "beta1"},
+      {[](auto& o) { o.beta1 = -0.1; }, "beta1"},   {[](auto& o) { o.beta2 = 1; }, "beta2"},
+      {[nan](auto& o) { o.beta2 = nan; }, "beta2"}, {[](auto& o) { o.lr = -1e-3; }, "lr"},
+      {[inf](auto& o) { o.lr = inf; }, "lr"},       {[](auto& o) { o.weight_decay = -0.01; }, "weight_decay"},
+  };
+  ag::Tensord p = ag::Tensord::from({1, 2}, {1.0, -3.0}, true);
+  for (const auto& [set, key] : bad) {
+    nn::AdamWOptions o;
+    set(o);
+    CAPTURE(key);
+    const std::string want = "AdamW: " + key + " must be";
+    CHECK_THROWS_WITH_AS(nn::AdamW<double>{o}, doctest::Contains(want.c_str()), ag::Error);
+    CHECK_THROWS_WITH_AS((nn::AdamW<float>{{}, o}), doctest::Contains(want.c_str()), ag::Error);
+    CHECK_THROWS_WITH_AS((nn::AdamW<double>{{{"p", p}}, o}), doctest::Contains(want.c_str()), ag::Error);
+  }
+  nn::AdamW<double> opt({{"p", p}});
+  CHECK_THROWS_WITH_AS(opt.set_lr(std::numeric_limits<double>::quiet_NaN()), doctest::Contains("AdamW: lr must be"),
+                       ag::Error);
+  CHECK(opt.lr() == 1e-3);  // unchanged by the refused value
+  opt.set_lr(0);            // the edges of the domain are taken
+  nn::AdamWOptions edge;
+  edge.beta1 = 0;
+  edge.beta2 = 0;
+  edge.weight_decay = 0;
+  CHECK_NOTHROW(nn::AdamW<double>{edge});
 }
 
 TEST_CASE("schedules: step decay halves every N steps down to the floor / loss-weight ramp") {

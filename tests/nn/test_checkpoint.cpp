@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 namespace {
 namespace fs = std::filesystem;
@@ -138,4 +139,32 @@ TEST_CASE("checkpoint: name, shape, dtype and optimizer mismatches are refused")
   CHECK_THROWS_WITH_AS(nn::load_checkpoint<double>(path, dbl, nullptr), doctest::Contains("float32"), ag::Error);
   nn::AdamW<float> opt(net.named_parameters());
   CHECK_THROWS_WITH_AS(nn::load_checkpoint<float>(path, net, &opt), doctest::Contains("optimizer"), ag::Error);
+}
+
+TEST_CASE("checkpoint: an optimizer lr outside its domain is refused before the model changes") {
+  nn::Rng rng(5);
+  nn::MLPStack<float> net({3, 5, 2}, false, false, rng);
+  nn::AdamW<float> opt(net.named_parameters());
+  train(net, opt, 2, 6);
+  const std::string path = tmp_path("nan_lr.ckpt");
+  nn::save_checkpoint<float>(path, net, &opt, 2, "{}");
+  // The options' first entry (lr) set to NaN, and the file rewritten with a valid checksum.
+  nn::Checkpoint ck = nn::read_checkpoint(path);
+  bool found = false;
+  for (nn::CheckpointEntry& e : ck.entries)
+    if (e.name == "adamw/#options") {
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      std::memcpy(e.bytes.data(), &nan, sizeof nan);
+      found = true;
+    }
+  REQUIRE(found);
+  nn::write_checkpoint(path, ck);
+
+  nn::MLPStack<float> other({3, 5, 2}, false, false, rng);
+  nn::AdamW<float> other_opt(other.named_parameters());
+  const std::vector<float> before = other.named_parameters().front().second.values();
+  CHECK_THROWS_WITH_AS(nn::load_checkpoint<float>(path, other, &other_opt), doctest::Contains("lr must be"), ag::Error);
+  CHECK(bits_equal(other.named_parameters().front().second.values(), before));  // untouched
+  CHECK(other_opt.lr() == 1e-3);
+  std::remove(path.c_str());
 }

@@ -17,19 +17,20 @@
 
 #include <cmath>
 #include <random>
+#include <sstream>
 #include <string>
 
 using namespace gdsr;
 
 namespace {
 // Plain Adam over the model's parameters (independent of nn's optimiser).
-struct Adam {
-  std::vector<ag::Tensorf> params;
-  std::vector<std::vector<float>> m, v;
+template <class T> struct Adam {
+  std::vector<ag::Tensor<T>> params;
+  std::vector<std::vector<T>> m, v;
   double lr, b1 = 0.9, b2 = 0.999, eps = 1e-8;
   int t = 0;
-  Adam(std::vector<ag::Tensorf> p, double lr_) : params(std::move(p)), lr(lr_) {
-    for (auto& x : params) m.emplace_back(x.numel(), 0.f), v.emplace_back(x.numel(), 0.f);
+  Adam(std::vector<ag::Tensor<T>> p, double lr_) : params(std::move(p)), lr(lr_) {
+    for (auto& x : params) m.emplace_back(x.numel(), T(0)), v.emplace_back(x.numel(), T(0));
   }
   void step(double lr_now) {
     lr = lr_now;
@@ -40,17 +41,22 @@ struct Adam {
       const auto& g = params[k].grad();
       auto& w = params[k].values();
       for (size_t i = 0; i < w.size(); ++i) {
-        m[k][i] = float(b1 * m[k][i] + (1 - b1) * g[i]);
-        v[k][i] = float(b2 * v[k][i] + (1 - b2) * g[i] * g[i]);
-        w[i] -= float(lr * (m[k][i] / c1) / (std::sqrt(v[k][i] / c2) + eps));
+        m[k][i] = T(b1 * m[k][i] + (1 - b1) * g[i]);
+        v[k][i] = T(b2 * v[k][i] + (1 - b2) * g[i] * g[i]);
+        w[i] -= T(lr * (m[k][i] / c1) / (std::sqrt(v[k][i] / c2) + eps));
       }
       params[k].zero_grad();
     }
   }
 };
-}  // namespace
 
-TEST_CASE("model overfit: a small model fits one frame pair (coarse + fine loss drop 10x)") {
+struct Overfit {
+  double first = 0, last = 0, first_c = 0, last_c = 0, first_f = 0, last_f = 0;
+  std::string report;
+};
+
+// Fits one frame pair with a model initialised from `seed`.
+template <class T> Overfit overfit(uint64_t seed) {
   const double size = 0.2;
   const GarmentMesh lr = gdsr_test::grid_garment(gdsr_test::GridSpec::square(5, size));
   GarmentMesh hr = gdsr_test::grid_garment(gdsr_test::GridSpec::square(17, size));
@@ -73,7 +79,8 @@ TEST_CASE("model overfit: a small model fits one frame pair (coarse + fine loss 
 
   ModelConfig cfg = load_model_config(std::string(GDSR_SOURCE_DIR) + "/configs/small.json");
   cfg.mp_steps = 2;
-  GDSR<float> model(cfg);
+  cfg.seed = seed;
+  GDSR<T> model(cfg);
   const GarmentGraph g = build_graph(lr);
 
   PatchConfig pc;
@@ -91,28 +98,53 @@ TEST_CASE("model overfit: a small model fits one frame pair (coarse + fine loss 
   lc.f_vgg.on = false;
   lc.schedule = false;
 
-  Adam opt(model.parameters(), 2e-3);
-  double first = 0, last = 0, first_c = 0, last_c = 0, first_f = 0, last_f = 0;
-  const int steps = 400;
+  const double lr0 = 1e-3;
+  const int steps = 600, warmup = 100;
+  Adam<T> opt(model.parameters(), lr0);
+  Overfit r;
   for (int s = 0; s < steps; ++s) {
     const auto out = model.forward(g, in, &req);
     const auto c = coarse_loss(lc, lr_topo, out.C_hat, C_star);
     const auto f = fine_loss(lc, batch, out.G, G_star);
-    const ag::Tensorf total = total_loss(Lambdas{1, 1}, c.total, f.total);
+    const ag::Tensor<T> total = total_loss(Lambdas{1, 1}, c.total, f.total);
     const double v = total.item();
     REQUIRE(std::isfinite(v));
-    if (s == 0) first = v, first_c = c.total.item(), first_f = f.total.item();
-    last = v, last_c = c.total.item(), last_f = f.total.item();
+    if (s == 0) r.first = v, r.first_c = c.total.item(), r.first_f = f.total.item();
+    r.last = v, r.last_c = c.total.item(), r.last_f = f.total.item();
     total.backward();
-    // Linear decay to 10%: at a constant rate Adam keeps oscillating near the minimum, and the
-    // last loss then depends on float32 rounding (Eigen's SIMD sums change with the heap
-    // alignment of the buffers: measured 4.7e-4 to 1.9e-3 for the fine term at 2e-3).
-    opt.step(2e-3 * (1.0 - 0.9 * s / steps));
+    // A linear warm-up over the first 100 steps, then a linear decay to 10%. Without the
+    // warm-up (the full rate from the first step) about half the initialisations stuck on a
+    // plateau at 2e-3 (2 of 16 at 1e-3): fine loss 1.76e-3, A's field never learns the wrinkles,
+    // a 3-8x drop only. Which ones
+    // changed with rounding: float32 and float64 runs of the same seed ended on different
+    // sides, so float64 alone did not make the test robust. With the warm-up 24 of 24 seeds fell
+    // 166-442x (fine) and relative changes of 1e-7 to 3e-6 to the initial parameters moved
+    // seed 1's result by less than 2x. Without the decay Adam keeps oscillating near the
+    // minimum and the last loss depends on float32 rounding.
+    opt.step(lr0 * (1.0 - 0.9 * s / steps) * (s < warmup ? double(s + 1) / warmup : 1.0));
   }
-  MESSAGE("loss " << first << " -> " << last << " (coarse " << first_c << " -> " << last_c << ", fine " << first_f
-                  << " -> " << last_f << ") in " << steps << " Adam steps; " << batch.vertices.size()
-                  << " HR samples on " << batch.lr_triangles.size() << " LR triangles");
-  CHECK(last < first / 10);
-  CHECK(last_c < first_c / 10);
-  CHECK(last_f < first_f / 10);
+  std::ostringstream m;
+  m << "seed " << seed << ": loss " << r.first << " -> " << r.last << " (coarse " << r.first_c << " -> " << r.last_c
+    << ", fine " << r.first_f << " -> " << r.last_f << ") in " << steps << " Adam steps; " << batch.vertices.size()
+    << " HR samples on " << batch.lr_triangles.size() << " LR triangles";
+  r.report = m.str();
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("model overfit: a small model fits one frame pair (coarse + fine loss drop 10x), 2 of 3 seeds at least") {
+  // Three initialisations (float32, as training runs), of which at least two must fit: one
+  // unlucky start (a rounding-level change can move a run into another basin) does not fail
+  // the test, a model or loss that stops fitting does. Measured: every seed of 1..24 falls
+  // 200x or more in total, so two failures out of three would be a real regression.
+  int fitted = 0;
+  for (uint64_t seed : {1, 2, 3}) {
+    const Overfit r = overfit<float>(seed);
+    const bool ok = r.last < r.first / 10 && r.last_c < r.first_c / 10 && r.last_f < r.first_f / 10;
+    const std::string note = ok ? "" : "  <- did not fall 10x";
+    MESSAGE(r.report << note);
+    fitted += ok ? 1 : 0;
+  }
+  CHECK(fitted >= 2);
 }
