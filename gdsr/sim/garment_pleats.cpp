@@ -2,7 +2,8 @@
 // general cone (apex on the body axis above the waist) over a wavy base curve, radius
 // r(y) (1 + q sin(N psi)) at height y and angle psi around the axis: a cone over any curve
 // is developable, so the flat pattern (front and back panels) is its exact development and
-// the placement is isometric. The waistband follows the pleats and is pinned.
+// the placement is isometric but for the waistband, which follows the pleats and, drawn in
+// to the waist section, is gathered and pinned.
 #include "gdsr/sim/garment_design.hpp"
 
 #include <algorithm>
@@ -108,10 +109,21 @@ GarmentDesign design_skirt_pleated(const BodyLandmarks& lm) {
     p = c->psi_of(f);
     return c->apex_y - r.norm() / c->dir(p).norm();
   };
-  d.place = [c, axis, height](int panel, const Vec2& uv) {
+  // The waistband follows the waist section, fading out above the hips, as for the cone
+  // skirts (place_cone in garment_cone.hpp says why).
+  const double fit_drop = std::min(0.1 * s, 0.7 * std::max(lm.waist_y - lm.hip_y, 0.0));
+  auto fit = std::make_shared<const BodyLandmarks>(lm);
+  d.place = [c, axis, height, fit, fit_drop, waist_y](int panel, const Vec2& uv) {
     double p;
     const double y = height(panel, uv, p);
-    const Vec3 g = c->dir(p) * (c->apex_y - y);
+    Vec3 g = c->dir(p) * (c->apex_y - y);
+    const double r = std::hypot(g.x(), g.z());
+    if (fit_drop > 0 && r > 0) {
+      const double t = std::clamp((waist_y - y) / fit_drop, 0.0, 1.0);
+      const double shrink = (fit->waist_r - waist_radius(*fit, std::atan2(g.x(), g.z()))) * (1 - t * t * (3 - 2 * t));
+      g.x() *= (r - shrink) / r;
+      g.z() *= (r - shrink) / r;
+    }
     return Vec3(axis.x() + g.x(), y, axis.z() + g.z());
   };
   d.pinned = [waist](int panel, const Vec2& uv) {  // on the waist edges of the outline

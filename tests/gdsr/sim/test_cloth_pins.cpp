@@ -115,7 +115,7 @@ TEST_CASE("pins: bad inputs are refused") {
   CHECK_THROWS_AS(sim::PinBinding({0}, far, none, body.F, body.V), gdsr::Error);
 }
 
-TEST_CASE("pins: a cone skirt's waistband follows the waist section, not the circle through its widest point") {
+TEST_CASE("pins: a skirt's waistband follows the waist section, not the circle through its widest point") {
   // Distances of the pinned waistband from the body, by an independent query (Embree). A round
   // waistband floated up to 56 mm off the belly and back of this body (10-56 mm); fitted, the
   // band keeps the design's ease (15 mm) all round, to the resolution of the body mesh.
@@ -124,7 +124,7 @@ TEST_CASE("pins: a cone skirt's waistband follows the waist section, not the cir
   gdsr::BodyOptions opt;
   opt.max_seconds = 0.01;
   const auto body = gdsr::load_body_sequence(bvh, opt);
-  for (const char* name : {"skirt_short", "skirt_layered", "skirt_tiered"}) {
+  for (const char* name : {"skirt_short", "skirt_layered", "skirt_tiered", "skirt_pleated"}) {
     const auto g = sim::make_garment(name, 0.02, body.rest_mesh());
     gdsr::BodyQuery query(body.rest_mesh());
     const auto hits = query.closest(rows_of(g.mesh.V, g.pinned));
@@ -137,6 +137,7 @@ TEST_CASE("pins: a cone skirt's waistband follows the waist section, not the cir
     }
     MESSAGE(std::string(name) << ": waistband " << lo * 1e3 << " to " << hi * 1e3 << " mm off the body");
     CHECK(lo > 0.008);
-    CHECK(hi < 0.025);
+    // The pleated waistband follows its pleats, whose outer folds stand ~35 mm further out.
+    CHECK(hi < (std::string(name) == "skirt_pleated" ? 0.055 : 0.025));
   }
 }
