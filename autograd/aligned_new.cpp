@@ -6,6 +6,9 @@
 // With one alignment for all large blocks the arithmetic is the same in every process.
 // Linked into every program through gdsr_autograd (the linker takes this object for the
 // first undefined operator new). Blocks come from malloc / aligned_alloc, freed with free.
+// Not in a sanitizer build (-DGDSR_SANITIZE=address, scripts/sanitize.sh): the ASan runtime
+// already defines operator new when the linker reaches this archive member, so ASan's own
+// allocator serves new (exact block sizes for its overflow checks, 16-byte alignment).
 #include <cstdlib>
 #include <new>
 
