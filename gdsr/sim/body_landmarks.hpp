@@ -48,6 +48,12 @@ struct BodyLandmarks {
 // waist_profile), interpolated between the measured directions.
 double waist_radius(const BodyLandmarks& lm, double psi);
 
+// How far (metres) a garment placed on a circle of radius waist_r around the axis draws in at
+// direction psi to follow the waist section instead, `below` metres under the waist: the full
+// waist_r - waist_radius(psi) at the waist, fading out (smoothstep) within 10 cm (less on a short
+// waist-to-hip drop), so the hips, which the garments clear with their ease, are untouched.
+double waist_fit_shrink(const BodyLandmarks& lm, double psi, double below);
+
 // Half extents of the trunk along x (|x - axis.x|) and z (|z - axis.z|) over the body's
 // vertices with y0 <= y <= y1 and horizontal distance from the axis below max_r (metres).
 // Returns (0, 0) when no vertex qualifies.

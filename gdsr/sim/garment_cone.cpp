@@ -55,17 +55,14 @@ SkirtLayout add_cone_skirt(Pattern& p, const Cone& c, double x_offset, const std
 }
 
 Vec3 place_cone(const SkirtLayout& s, int k, const Vec2& uv, const Vec3& axis, double waist_y,
-                const BodyLandmarks* fit, double fit_drop) {
+                const BodyLandmarks* fit) {
   const Vec2 d = uv - s.apex[k];
   const double rho = d.norm();
   const double phi = std::atan2(d.y(), d.x()) + kPi / 2;  // 0 at the panel centre
   const double psi = phi / s.cone.sin_a + (k == 0 ? 0.0 : kPi);
   const double apex_y = waist_y + s.cone.R1 * s.cone.cos_a;
   double r = rho * s.cone.sin_a;
-  if (fit && fit_drop > 0) {
-    const double t = std::clamp((rho - s.cone.R1) / fit_drop, 0.0, 1.0);
-    r -= (fit->waist_r - waist_radius(*fit, psi)) * (1 - t * t * (3 - 2 * t));
-  }
+  if (fit) r -= waist_fit_shrink(*fit, psi, rho - s.cone.R1);
   return Vec3(axis.x() + r * std::sin(psi), apex_y - rho * s.cone.cos_a, axis.z() + r * std::cos(psi));
 }
 
@@ -87,11 +84,9 @@ void finish_cone_design(GarmentDesign& d, std::shared_ptr<const std::vector<Skir
                         bool layered) {
   const Vec3 axis = lm.axis;
   const double waist_y = lm.waist_y;
-  // The fit fades out above the hips (which the cone clears with its ease).
-  const double drop = std::min(0.1 * lm.height / 1.75, 0.7 * std::max(lm.waist_y - lm.hip_y, 0.0));
   auto fit = std::make_shared<const BodyLandmarks>(lm);
-  d.place = [lays, axis, waist_y, fit, drop](int panel, const Vec2& uv) {
-    return place_cone((*lays)[panel / 2], panel % 2, uv, axis, waist_y, fit.get(), drop);
+  d.place = [lays, axis, waist_y, fit](int panel, const Vec2& uv) {
+    return place_cone((*lays)[panel / 2], panel % 2, uv, axis, waist_y, fit.get());
   };
   d.pinned = [lays](int panel, const Vec2& uv) {
     const SkirtLayout& L = (*lays)[panel / 2];

@@ -43,14 +43,14 @@ SkirtLayout add_cone_skirt(Pattern& p, const Cone& c, double x_offset, const std
 // 3-D point (metres) of point uv of panel k (0 front, 1 back) of a cone whose waist circle is
 // at height waist_y around the vertical axis through `axis`; psi = 0 is the body's front (+z).
 // With a body `fit` (lm.waist_profile), the waistband follows the waist section instead of
-// the circle through its widest point: the radius shrinks by waist_r - waist_radius(psi) at
-// the waist, fading out (smoothstep) over `fit_drop` metres of slant below it. A round
+// the circle through its widest point (waist_fit_shrink, with the slant distance below the
+// waist). A round
 // waistband around an oval waist floats 4-5 cm off the belly and the back, where a hand
 // resting on the hip then pushes the held cloth into the body (CMU salsa 61_02: 25 mm). Not
 // isometric near the waist: the settle eases the pattern's lengths in (gathers, as an
 // elastic waistband has).
 gdsr::Vec3 place_cone(const SkirtLayout& s, int k, const gdsr::Vec2& uv, const gdsr::Vec3& axis, double waist_y,
-                      const BodyLandmarks* fit = nullptr, double fit_drop = 0);
+                      const BodyLandmarks* fit = nullptr);
 
 // Waist radius waist_r + ease and the hem radius needed to clear the hips with `ease` metres
 // (at least a + min_flare).

@@ -109,18 +109,16 @@ GarmentDesign design_skirt_pleated(const BodyLandmarks& lm) {
     p = c->psi_of(f);
     return c->apex_y - r.norm() / c->dir(p).norm();
   };
-  // The waistband follows the waist section, fading out above the hips, as for the cone
-  // skirts (place_cone in garment_cone.hpp says why).
-  const double fit_drop = std::min(0.1 * s, 0.7 * std::max(lm.waist_y - lm.hip_y, 0.0));
+  // The waistband follows the waist section, as for the cone skirts (place_cone in
+  // garment_cone.hpp says why).
   auto fit = std::make_shared<const BodyLandmarks>(lm);
-  d.place = [c, axis, height, fit, fit_drop, waist_y](int panel, const Vec2& uv) {
+  d.place = [c, axis, height, fit, waist_y](int panel, const Vec2& uv) {
     double p;
     const double y = height(panel, uv, p);
     Vec3 g = c->dir(p) * (c->apex_y - y);
     const double r = std::hypot(g.x(), g.z());
-    if (fit_drop > 0 && r > 0) {
-      const double t = std::clamp((waist_y - y) / fit_drop, 0.0, 1.0);
-      const double shrink = (fit->waist_r - waist_radius(*fit, std::atan2(g.x(), g.z()))) * (1 - t * t * (3 - 2 * t));
+    if (r > 0) {
+      const double shrink = waist_fit_shrink(*fit, std::atan2(g.x(), g.z()), waist_y - y);
       g.x() *= (r - shrink) / r;
       g.z() *= (r - shrink) / r;
     }
