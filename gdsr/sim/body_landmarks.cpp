@@ -290,11 +290,85 @@ double waist_radius(const BodyLandmarks& lm, double psi) {
   return (1 - a) * lm.waist_profile[i] + a * lm.waist_profile[(i + 1) % n];
 }
 
-double waist_fit_shrink(const BodyLandmarks& lm, double psi, double below) {
-  const double drop = std::min(0.1 * lm.height / 1.75, 0.7 * std::max(lm.waist_y - lm.hip_y, 0.0));
-  if (!(drop > 0)) return 0;
+namespace {
+// Metres under the waist over which a waist fit fades out (see WaistCurve::weight).
+double waist_fit_drop(const BodyLandmarks& lm) {
+  return std::min(0.1 * lm.height / 1.75, 0.7 * std::max(lm.waist_y - lm.hip_y, 0.0));
+}
+// Fraction of a waist fit applied `below` metres under the waist: smoothstep from 1 to 0 over `drop`.
+double waist_fit_weight(double drop, double below) {
+  if (!(drop > 0)) return below <= 0 ? 1.0 : 0.0;
   const double t = std::clamp(below / drop, 0.0, 1.0);
-  return (lm.waist_r - waist_radius(lm, psi)) * (1 - t * t * (3 - 2 * t));
+  return 1 - t * t * (3 - 2 * t);
+}
+}  // namespace
+
+double waist_fit_shrink(const BodyLandmarks& lm, double psi, double below) {
+  return (lm.waist_r - waist_radius(lm, psi)) * waist_fit_weight(waist_fit_drop(lm), below);
+}
+
+namespace {
+constexpr double kTwoPi = 6.283185307179586;
+
+// Radii (ease added) of the waist section at the profile's directions, and the arc lengths
+// of the closed polygon through them from direction 0 (size n + 1).
+void waist_polygon(const BodyLandmarks& lm, double ease, std::vector<double>& r, std::vector<double>& arc) {
+  const int n = lm.waist_profile.empty() ? BodyLandmarks::kWaistBins : static_cast<int>(lm.waist_profile.size());
+  r.resize(n);
+  for (int k = 0; k < n; ++k) r[k] = (lm.waist_profile.empty() ? lm.waist_r : lm.waist_profile[k]) + ease;
+  arc.assign(n + 1, 0.0);
+  for (int k = 0; k < n; ++k) {
+    const double p0 = kTwoPi * k / n, p1 = kTwoPi * (k + 1) / n;
+    const double q = r[(k + 1) % n];
+    arc[k + 1] = arc[k] + std::hypot(q * std::sin(p1) - r[k] * std::sin(p0), q * std::cos(p1) - r[k] * std::cos(p0));
+  }
+}
+}  // namespace
+
+double waist_perimeter(const BodyLandmarks& lm, double ease) {
+  std::vector<double> r, arc;
+  waist_polygon(lm, ease, r, arc);
+  return arc.back();
+}
+
+WaistCurve::WaistCurve(const BodyLandmarks& lm, double a) {
+  // The perimeter grows with the ease (by 2 pi per metre on a convex section): bisection.
+  const double target = kTwoPi * a;
+  double lo = 0, hi = std::max(a, 0.0);
+  if (waist_perimeter(lm, 0) < target) {
+    for (int it = 0; it < 60; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (waist_perimeter(lm, mid) < target ? lo : hi) = mid;
+    }
+    ease_ = 0.5 * (lo + hi);
+  }
+  waist_polygon(lm, ease_, r_, arc_);
+  drop_ = std::max(lm.waist_y - lm.hip_y, 0.0);
+}
+
+double WaistCurve::radius(double psi) const {
+  const int n = static_cast<int>(r_.size());
+  double t = psi / kTwoPi * n;
+  t -= n * std::floor(t / n);
+  const int i = std::min(static_cast<int>(t), n - 1);
+  const double w = t - i;
+  return (1 - w) * r_[i] + w * r_[(i + 1) % n];
+}
+
+double WaistCurve::psi_at(double f) const {
+  const int n = static_cast<int>(r_.size());
+  const double s = (f - std::floor(f)) * arc_[n];
+  const int i =
+      std::clamp(static_cast<int>(std::upper_bound(arc_.begin(), arc_.end(), s) - arc_.begin()) - 1, 0, n - 1);
+  const double len = arc_[i + 1] - arc_[i];
+  const double w = len > 0 ? std::clamp((s - arc_[i]) / len, 0.0, 1.0) : 0.0;
+  return kTwoPi * (i + w) / n;
+}
+
+double WaistCurve::weight(double below) const {
+  if (!(drop_ > 0)) return below <= 0 ? 1.0 : 0.0;
+  const double t = std::clamp(below / drop_, 0.0, 1.0);
+  return 1 - t * t;
 }
 
 }  // namespace sim

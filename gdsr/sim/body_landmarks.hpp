@@ -54,6 +54,32 @@ double waist_radius(const BodyLandmarks& lm, double psi);
 // waist-to-hip drop), so the hips, which the garments clear with their ease, are untouched.
 double waist_fit_shrink(const BodyLandmarks& lm, double psi, double below);
 
+// The waist section (waist_profile) grown outwards by an ease e until its perimeter is
+// 2 pi a, the length of a cone skirt's waistband of radius a: laid along it by arc length, the
+// waistband neither stretches nor gathers. Without a measured profile, the circle of radius a.
+class WaistCurve {
+ public:
+  WaistCurve(const BodyLandmarks& lm, double a);
+  double ease() const { return ease_; }  // metres (0 when even the bare section is longer than 2 pi a)
+  double radius(double psi) const;       // metres from the axis in direction psi (see waist_profile)
+  // Direction psi (radians, in [0, 2 pi)) of the point a fraction f of the perimeter round from
+  // the front (psi = 0) towards increasing psi; f wraps.
+  double psi_at(double f) const;
+  // How much of the fit applies `below` metres under the waist: 1 - t^2, t = below / (waist to
+  // hip drop) clamped to [0, 1]. Where the section is wider than the cone (the sides) the skirt
+  // stays out at least as far as the straight cone through the widest point; the smoothstep over
+  // 10 cm of the radial fit cut 8 mm into a salsa dancer's hips (4 mm with this).
+  double weight(double below) const;
+
+ private:
+  std::vector<double> r_;    // m, radius at psi_k = 2 pi k / n (ease included)
+  std::vector<double> arc_;  // m, arc length from psi_0 to psi_k, k = 0..n (arc_[n]: the perimeter)
+  double ease_ = 0, drop_ = 0;  // m
+};
+
+// Perimeter (metres) of the waist section grown outwards by `ease` metres.
+double waist_perimeter(const BodyLandmarks& lm, double ease);
+
 // Half extents of the trunk along x (|x - axis.x|) and z (|z - axis.z|) over the body's
 // vertices with y0 <= y <= y1 and horizontal distance from the axis below max_r (metres).
 // Returns (0, 0) when no vertex qualifies.

@@ -55,19 +55,28 @@ SkirtLayout add_cone_skirt(Pattern& p, const Cone& c, double x_offset, const std
 }
 
 Vec3 place_cone(const SkirtLayout& s, int k, const Vec2& uv, const Vec3& axis, double waist_y,
-                const BodyLandmarks* fit) {
+                const WaistCurve* waist) {
   const Vec2 d = uv - s.apex[k];
   const double rho = d.norm();
   const double phi = std::atan2(d.y(), d.x()) + kPi / 2;  // 0 at the panel centre
-  const double psi = phi / s.cone.sin_a + (k == 0 ? 0.0 : kPi);
+  double psi = phi / s.cone.sin_a + (k == 0 ? 0.0 : kPi);
   const double apex_y = waist_y + s.cone.R1 * s.cone.cos_a;
   double r = rho * s.cone.sin_a;
-  if (fit) r -= waist_fit_shrink(*fit, psi, rho - s.cone.R1);
+  if (waist) {
+    const double w = waist->weight((rho - s.cone.R1) * s.cone.cos_a);
+    if (w > 0) {
+      const double psi_lin = psi;
+      double shift = waist->psi_at(psi_lin / (2 * kPi)) - psi_lin;  // the same fraction of the way round
+      shift -= 2 * kPi * std::round(shift / (2 * kPi));
+      psi = psi_lin + w * shift;
+      r += w * (waist->radius(psi) - s.cone.a);
+    }
+  }
   return Vec3(axis.x() + r * std::sin(psi), apex_y - rho * s.cone.cos_a, axis.z() + r * std::cos(psi));
 }
 
 Cone skirt_cone(const BodyLandmarks& lm, double length, double min_flare, double ease) {
-  const double a = lm.waist_r + ease;
+  const double a = waist_perimeter(lm, ease) / (2 * kPi);
   const double drop = std::max(lm.waist_y - lm.hip_y, 0.02);
   const double need = a + (lm.hip_r + 2 * ease - a) * length / drop;
   return Cone(a, std::max({need, a + min_flare, a + 0.02}), length);
@@ -84,9 +93,10 @@ void finish_cone_design(GarmentDesign& d, std::shared_ptr<const std::vector<Skir
                         bool layered) {
   const Vec3 axis = lm.axis;
   const double waist_y = lm.waist_y;
-  auto fit = std::make_shared<const BodyLandmarks>(lm);
-  d.place = [lays, axis, waist_y, fit](int panel, const Vec2& uv) {
-    return place_cone((*lays)[panel / 2], panel % 2, uv, axis, waist_y, fit.get());
+  auto waists = std::make_shared<std::vector<WaistCurve>>();
+  for (const SkirtLayout& L : *lays) waists->emplace_back(lm, L.cone.a);
+  d.place = [lays, axis, waist_y, waists](int panel, const Vec2& uv) {
+    return place_cone((*lays)[panel / 2], panel % 2, uv, axis, waist_y, &(*waists)[panel / 2]);
   };
   d.pinned = [lays](int panel, const Vec2& uv) {
     const SkirtLayout& L = (*lays)[panel / 2];

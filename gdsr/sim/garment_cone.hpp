@@ -42,18 +42,18 @@ SkirtLayout add_cone_skirt(Pattern& p, const Cone& c, double x_offset, const std
 
 // 3-D point (metres) of point uv of panel k (0 front, 1 back) of a cone whose waist circle is
 // at height waist_y around the vertical axis through `axis`; psi = 0 is the body's front (+z).
-// With a body `fit` (lm.waist_profile), the waistband follows the waist section instead of
-// the circle through its widest point (waist_fit_shrink, with the slant distance below the
-// waist). A round
-// waistband around an oval waist floats 4-5 cm off the belly and the back, where a hand
-// resting on the hip then pushes the held cloth into the body (CMU salsa 61_02: 25 mm). Not
-// isometric near the waist: the settle eases the pattern's lengths in (gathers, as an
-// elastic waistband has).
+// With a `waist` curve (the body's waist section grown to the cone's waist length 2 pi a), the
+// waistband lies along that curve by arc length instead of on the circle, blending back to the
+// cone within WaistCurve::weight's fade: a round waistband around an oval waist floats 4-5 cm
+// off the belly and the back, where a hand resting on the hip then pushes the held cloth into
+// the body (CMU salsa 61_02: 25 mm). Along the curve the waistband keeps its pattern length
+// (drawing the circle in radially instead gathered it, and a 30 mm mesh took the excess up in
+// one flap down the front).
 gdsr::Vec3 place_cone(const SkirtLayout& s, int k, const gdsr::Vec2& uv, const gdsr::Vec3& axis, double waist_y,
-                      const BodyLandmarks* fit = nullptr);
+                      const WaistCurve* waist = nullptr);
 
-// Waist radius waist_r + ease and the hem radius needed to clear the hips with `ease` metres
-// (at least a + min_flare).
+// Waist radius a such that the waist section grown by `ease` metres has perimeter 2 pi a, and
+// the hem radius needed to clear the hips with `ease` metres (at least a + min_flare).
 Cone skirt_cone(const BodyLandmarks& lm, double length, double min_flare, double ease);
 
 // Places, pins and layers a design made only of nested cone skirts: panels 2k, 2k + 1 are

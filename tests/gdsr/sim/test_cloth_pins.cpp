@@ -3,12 +3,14 @@
 #include "gdsr/body/body.hpp"
 #include "gdsr/body/body_query.hpp"
 #include "gdsr/error.hpp"
+#include "gdsr/sim/body_landmarks.hpp"
 #include "gdsr/sim/cloth_pins.hpp"
 #include "gdsr/sim/garments.hpp"
 #include "tests/support/cloth_bodies.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <string>
@@ -139,5 +141,46 @@ TEST_CASE("pins: a skirt's waistband follows the waist section, not the circle t
     CHECK(lo > 0.008);
     // The pleated waistband follows its pleats, whose outer folds stand ~35 mm further out.
     CHECK(hi < (std::string(name) == "skirt_pleated" ? 0.055 : 0.025));
+    // The cone skirts' waistbands lie along the section at their pattern length (edges between
+    // two pins, 3-D against flat length); drawn in radially they were gathered to 0.75x.
+    if (std::string(name) == "skirt_pleated") continue;
+    std::vector<char> pin(g.mesh.V.rows(), 0);
+    for (int v : g.pinned) pin[v] = 1;
+    double worst = 0;
+    for (int f = 0; f < g.mesh.F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const int a = g.mesh.F(f, k), b = g.mesh.F(f, (k + 1) % 3);
+        if (!pin[a] || !pin[b]) continue;
+        const double flat = (g.mesh.UV.row(g.mesh.FUV(f, k)) - g.mesh.UV.row(g.mesh.FUV(f, (k + 1) % 3))).norm();
+        worst = std::max(worst, std::abs((g.mesh.V.row(a) - g.mesh.V.row(b)).norm() / flat - 1));
+      }
+    MESSAGE(std::string(name) << ": waistband edges within " << worst * 100 << "% of their pattern length");
+    CHECK(worst < 0.02);
   }
+}
+
+TEST_CASE("pins: the waist curve has the perimeter asked for and is laid out by arc length") {
+  const auto lm = sim::measure_body(sim::make_mannequin(1.7));
+  const double a = sim::waist_perimeter(lm, 0.015) / (2 * M_PI);
+  const sim::WaistCurve c(lm, a);
+  CHECK(c.ease() == doctest::Approx(0.015).epsilon(1e-6));
+  // Equal steps of the fraction are equal steps of arc length (a fine polygon through it).
+  const int n = 720;
+  double total = 0, lo = 1e9, hi = 0;
+  for (int i = 0; i < n; ++i) {
+    auto at = [&](double f) {
+      const double psi = c.psi_at(f), r = c.radius(psi);
+      return Eigen::Vector2d(r * std::sin(psi), r * std::cos(psi));
+    };
+    const double step = (at((i + 1.0) / n) - at(static_cast<double>(i) / n)).norm();
+    total += step;
+    lo = std::min(lo, step);
+    hi = std::max(hi, step);
+  }
+  CHECK(total == doctest::Approx(2 * M_PI * a).epsilon(1e-3));
+  CHECK(hi / lo < 1.05);
+  CHECK(c.psi_at(0) == doctest::Approx(0).epsilon(1e-12));
+  CHECK(c.psi_at(1.25) == doctest::Approx(c.psi_at(0.25)).epsilon(1e-12));
+  // A bare section longer than asked for: no ease (and no negative one).
+  CHECK(sim::WaistCurve(lm, 0.01).ease() == 0);
 }

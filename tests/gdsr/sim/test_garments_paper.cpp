@@ -149,15 +149,16 @@ TEST_CASE("garments: the paper's five garments rest outside the body, unstrained
       CHECK(self_intersections(m.V, m.F) == 0);
       // Rest strain against the flat pattern: developable pieces are isometric; the t-shirt's
       // shoulder fold shears (E_uv) and the pants' crotch blend stretches (E_v) locally, and the
-      // tiered and pleated skirts' waistbands, drawn in to the waist section, are gathered (E_v,
-      // E_uv 0.012-0.014 tiered, 0.015-0.021 pleated).
+      // pleated skirt's waistband, drawn in to the waist section, is gathered (E_v, E_uv
+      // 0.015-0.021). The cone skirts follow the waist section along its length (isometric at the
+      // waist; the blend below it strains the tiered skirt to E_u 0.002, E_uv 0.004).
       const auto se = gdsr::strain_energies(m, m.V);
       CAPTURE(se.E_u);
       CAPTURE(se.E_v);
       CAPTURE(se.E_uv);
       const bool cones = name != "tshirt" && name != "pants";
       CHECK(se.E_u < 0.005);
-      const bool fitted = name == "skirt_tiered" || name == "skirt_pleated";
+      const bool fitted = name == "skirt_pleated";
       CHECK(se.E_v < (name == "pants" ? 0.12 : fitted ? 0.03 : 0.005));
       CHECK(se.E_uv < (cones && !fitted ? 0.005 : fitted ? 0.03 : 0.07));
       // Layers exactly where the garment has them.
