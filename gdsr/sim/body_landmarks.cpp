@@ -331,7 +331,7 @@ double waist_perimeter(const BodyLandmarks& lm, double ease) {
   return arc.back();
 }
 
-WaistCurve::WaistCurve(const BodyLandmarks& lm, double a) {
+WaistCurve::WaistCurve(const BodyLandmarks& lm, double a, double drop) {
   // The perimeter grows with the ease (by 2 pi per metre on a convex section): bisection.
   const double target = kTwoPi * a;
   double lo = 0, hi = std::max(a, 0.0);
@@ -343,7 +343,7 @@ WaistCurve::WaistCurve(const BodyLandmarks& lm, double a) {
     ease_ = 0.5 * (lo + hi);
   }
   waist_polygon(lm, ease_, r_, arc_);
-  drop_ = std::max(lm.waist_y - lm.hip_y, 0.0);
+  drop_ = drop > 0 ? drop : std::max(lm.waist_y - lm.hip_y, 0.0);
 }
 
 double WaistCurve::radius(double psi) const {

@@ -59,14 +59,15 @@ double waist_fit_shrink(const BodyLandmarks& lm, double psi, double below);
 // waistband neither stretches nor gathers. Without a measured profile, the circle of radius a.
 class WaistCurve {
  public:
-  WaistCurve(const BodyLandmarks& lm, double a);
+  // drop: metres under the waist over which the fit fades out (weight); <= 0: the waist-to-hip drop.
+  WaistCurve(const BodyLandmarks& lm, double a, double drop = 0);
   double ease() const { return ease_; }  // metres (0 when even the bare section is longer than 2 pi a)
   double radius(double psi) const;       // metres from the axis in direction psi (see waist_profile)
   // Direction psi (radians, in [0, 2 pi)) of the point a fraction f of the perimeter round from
   // the front (psi = 0) towards increasing psi; f wraps.
   double psi_at(double f) const;
-  // How much of the fit applies `below` metres under the waist: 1 - t^2, t = below / (waist to
-  // hip drop) clamped to [0, 1]. Where the section is wider than the cone (the sides) the skirt
+  // How much of the fit applies `below` metres under the waist: 1 - t^2, t = below / drop
+  // clamped to [0, 1]. Where the section is wider than the cone (the sides) the skirt
   // stays out at least as far as the straight cone through the widest point; the smoothstep over
   // 10 cm of the radial fit cut 8 mm into a salsa dancer's hips (4 mm with this).
   double weight(double below) const;

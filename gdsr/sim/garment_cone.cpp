@@ -21,11 +21,11 @@ Cone::Cone(double a_, double b_, double L_) : a(a_), b(b_), L(L_) {
 }
 
 SkirtLayout add_cone_skirt(Pattern& p, const Cone& c, double x_offset, const std::string& name, int n_inner,
-                           const Scallops& hem) {
+                           const Scallops& hem, int n_outer) {
   const double R2 = c.R1 + c.Ls;
   const double half = c.theta / 4;  // each panel spans theta / 2
   const double hem_step = hem.depth > 0 ? std::min(0.03, hem.length / 8) : 0.03;
-  const int n_outer = std::max(8, static_cast<int>(std::ceil(R2 * 2 * half / hem_step)));
+  if (n_outer <= 0) n_outer = std::max(8, static_cast<int>(std::ceil(R2 * 2 * half / hem_step)));
   if (n_inner <= 0) n_inner = std::max(4, static_cast<int>(std::ceil(c.R1 * 2 * half / 0.03)));
   const double width = 2 * R2 * std::sin(std::min(half, kPi / 2)) + 0.05;
   SkirtLayout lay{c, {}, n_outer, n_inner};

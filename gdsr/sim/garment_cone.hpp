@@ -34,11 +34,12 @@ struct Scallops {
 
 // Appends the two panels of a cone skirt (panel indices base, base + 1) at flat x >= x_offset
 // and their two side seams. n_inner > 0 fixes the number of edges on each waist arc (to sew
-// the waist to another panel); 0 picks ~3 cm edges. Panel edges: 0 .. n_outer-1 hem,
+// the waist to another panel), n_outer > 0 those on each hem arc; 0 picks ~3 cm edges. Panel
+// edges: 0 .. n_outer-1 hem (psi increasing),
 // n_outer radial (+angle end), n_outer+1 .. n_outer+n_inner waist arc (from the body's +x
 // side towards -x for the front), last: radial (-angle end).
 SkirtLayout add_cone_skirt(Pattern& p, const Cone& c, double x_offset, const std::string& name, int n_inner = 0,
-                           const Scallops& hem = {});
+                           const Scallops& hem = {}, int n_outer = 0);
 
 // 3-D point (metres) of point uv of panel k (0 front, 1 back) of a cone whose waist circle is
 // at height waist_y around the vertical axis through `axis`; psi = 0 is the body's front (+z).

@@ -1,13 +1,17 @@
-// Long pants: front and back panels like the shorts (garment_tubes.cpp), with legs down to
-// the ankles that taper to a hem of ~15 cm diameter. Each leg tube follows the body's leg
-// from the crotch to the ankle (spread legs tilt it), so the legs clear the body; above
-// the crotch the tubes blend into the hip cylinder. Side seams and inseams; the waistband
-// is pinned.
+// Long pants: front and back leg panels like the shorts (garment_tubes.cpp), with legs down
+// to the ankles that taper to a hem of ~15 cm diameter. Each leg tube follows the body's leg
+// from the crotch to the ankle (spread legs tilt it), so the legs clear the body; above the
+// crotch the tubes blend into the hip cylinder. Above the hips a yoke, a cone frustum like a
+// short skirt's (garment_cone.hpp), narrows from the hip cylinder to the waist section, which
+// its waistband follows at its pattern length; it is sewn to the legs along the hip line.
+// Side seams, inseams and the hip seam; the waistband is pinned.
+#include "gdsr/sim/garment_cone.hpp"
 #include "gdsr/sim/garment_design.hpp"
 #include "gdsr/sim/garment_legs.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 namespace sim {
@@ -31,7 +35,32 @@ GarmentDesign design_pants(const BodyLandmarks& lm) {
   const double Hc = lm.crotch_y - 0.03 * s - hem_y;
   const double r_hem = 0.075 * s;
   const double g = std::max(0.02 * s, W / 2 - kPi * r_hem), blend = 0.10 * s;
-  add_two_leg_panels(p, W, Htot, Hc, g, "pants");
+  // The hip line: at the hips, but above the legs' blend into the hip cylinder.
+  const double Ht = std::min(std::max(lm.hip_y - hem_y, Hc + blend), Htot - 0.04 * s);
+  const double ease = 0.015 * s;
+  const double a = waist_perimeter(lm, ease) / (2 * kPi);
+  const Cone yoke(a, std::max(R, a + 0.01 * s), Htot - Ht);
+  // Leg panels up to the hip line, whose edge is split like the yoke's lower arc. Outline:
+  // hem, inseams, hem (edges 0-3), side seam up (4), hip line from +x to -x (5 .. 4 + n),
+  // side seam down (5 + n).
+  const int n = std::max(8, static_cast<int>(std::ceil(kPi * yoke.b / 0.03)));
+  for (int panel = 0; panel < 2; ++panel) {
+    std::vector<Vec2> o{Vec2(-W / 2, 0), Vec2(-g, 0), Vec2(0, Hc), Vec2(g, 0), Vec2(W / 2, 0)};
+    for (int i = 0; i < n; ++i) o.push_back(Vec2(W / 2 - W * i / n, Ht));
+    o.push_back(Vec2(-W / 2, Ht));
+    for (auto& v : o) v.x() += panel * (W + 0.1);
+    p.panels.push_back({panel == 0 ? "pants_front" : "pants_back", o});
+  }
+  p.seams.push_back({0, 4, 1, 5 + n, true});  // side seams
+  p.seams.push_back({1, 4, 0, 5 + n, true});
+  p.seams.push_back({0, 1, 1, 2, true});  // inseams
+  p.seams.push_back({0, 2, 1, 1, true});
+  // The yoke (panels 2, 3): its lower arc's edge j (psi increasing) meets hip-line edge n - 1 - j.
+  auto lay = std::make_shared<SkirtLayout>(add_cone_skirt(p, yoke, pattern_max_x(p) + 0.1, "pants_yoke", 0, {}, n));
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < n; ++j) p.seams.push_back({2 + k, j, k, 5 + (n - 1 - j), true});
+  // Its waist fit fades out over the whole yoke, so that its lower arc is the hip circle.
+  auto waist = std::make_shared<const WaistCurve>(lm, a, yoke.L);
   // Each leg tube is a tilted cone around the body leg's line (from `top` at the crotch
   // height, R/2 to the side, to the leg's centre near the ankle); below the top quarter its
   // cross-sections are perpendicular to that line (e1 outwards, e2 forwards), so the
@@ -48,7 +77,9 @@ GarmentDesign design_pants(const BodyLandmarks& lm) {
     e1[k] = (side * Vec3::UnitX() - dir[k] * (side * dir[k].x())).normalized();
     e2[k] = (Vec3::UnitZ() - dir[k] * dir[k].z() - e1[k] * e1[k].z()).normalized();
   }
+  const double waist_y = lm.waist_y;
   d.place = [=](int panel, const Vec2& uv) {
+    if (panel >= 2) return place_cone(*lay, panel - 2, uv, axis, waist_y, waist.get());
     const LegCoords lc = leg_coords(panel, uv, W, R, hem_y, Hc, g, blend);
     if (lc.on_hip) return Vec3(axis + lc.hip);
     const double y = uv.y(), t = lc.t, r = lc.r, zs = lc.zs;
@@ -63,7 +94,9 @@ GarmentDesign design_pants(const BodyLandmarks& lm) {
     const Vec3 leg = c + r * std::cos(kPi * t) * f1 + zs * r * std::sin(kPi * t) * f2;
     return Vec3(axis + (1 - lc.blend) * leg + lc.blend * lc.hip);
   };
-  d.pinned = [Htot](int, const Vec2& uv) { return uv.y() > Htot - 1e-9; };  // waistband
+  d.pinned = [lay](int panel, const Vec2& uv) {  // the yoke's waistband
+    return panel >= 2 && (uv - lay->apex[panel - 2]).norm() < lay->cone.R1 + 1e-9;
+  };
   return d;
 }
 
