@@ -117,7 +117,7 @@ TEST_CASE("pins: bad inputs are refused") {
   CHECK_THROWS_AS(sim::PinBinding({0}, far, none, body.F, body.V), gdsr::Error);
 }
 
-TEST_CASE("pins: a skirt's waistband follows the waist section, not the circle through its widest point") {
+TEST_CASE("pins: skirts' and pants' waistbands follow the waist section, not the circle through its widest point") {
   // Distances of the pinned waistband from the body, by an independent query (Embree). A round
   // waistband floated up to 56 mm off the belly and back of this body (10-56 mm); fitted, the
   // band keeps the design's ease (15 mm) all round, to the resolution of the body mesh.
@@ -126,7 +126,7 @@ TEST_CASE("pins: a skirt's waistband follows the waist section, not the circle t
   gdsr::BodyOptions opt;
   opt.max_seconds = 0.01;
   const auto body = gdsr::load_body_sequence(bvh, opt);
-  for (const char* name : {"skirt_short", "skirt_layered", "skirt_tiered", "skirt_pleated"}) {
+  for (const char* name : {"skirt_short", "skirt_layered", "skirt_tiered", "skirt_pleated", "pants"}) {
     const auto g = sim::make_garment(name, 0.02, body.rest_mesh());
     gdsr::BodyQuery query(body.rest_mesh());
     const auto hits = query.closest(rows_of(g.mesh.V, g.pinned));
