@@ -197,6 +197,7 @@ void run_make(const MakeArgs& a) {
                   {"settle_rest_blend", params.settle_rest_blend},
                   {"self_collision", params.self_collision},
                   {"self_thickness_m", params.self_thickness},
+                  {"self_thickness_per_pd", params.self_thickness_per_pd},
                   {"self_slack_m", params.self_slack},
                   {"self_detect_every", params.self_detect_every},
                   {"compression_ratio", params.compression_ratio},
@@ -523,7 +524,7 @@ void add_data_command(CLI::App& app) {
       ->check(finite_range(0.0, 2.0));
   make->add_option("--bend-stiffness", mk->bend_stiffness, "bending modulus, N m (default: the solver's)")
       ->check(finite_range(0.0, 1.0));
-  make->add_option("--self-thickness", mk->self_thickness, "cloth-cloth distance kept, metres (default: the solver's)")
+  make->add_option("--self-thickness", mk->self_thickness, "least cloth-cloth distance kept, metres (default: the solver's; the solver also keeps 1/6 of the particle distance)")
       ->check(finite_range(0.0, 0.05));
   make->add_option("--self-slack", mk->self_slack,
                    "metres a vertex may leave its predicted path before self-contacts are re-detected"

@@ -182,9 +182,12 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
   body_cell_ = cell;
   xprev_ = x_;
   if (p.self_collision) {
-    if (!(p.self_thickness > 0) || p.self_detect_every < 1 || !(p.self_slack > 0) || p.self_passes < 1)
+    if (!(p.self_thickness > 0) || p.self_detect_every < 1 || !(p.self_slack > 0) || p.self_passes < 1 ||
+        !(p.self_thickness_per_pd >= 0))
       gdsr::fail("sim/cloth_solver",
-                 "self_thickness and self_slack must be positive, self_detect_every and self_passes >= 1");
+                 "self_thickness and self_slack must be positive, self_thickness_per_pd >= 0, self_detect_every and "
+                 "self_passes >= 1");
+    p_.self_thickness = std::max(p.self_thickness, p.self_thickness_per_pd * g.particle_distance);
     self_ = std::make_unique<SelfCollision>(F_, nv);
     motion_ = Points3::Zero(nv, 3);
   }
