@@ -201,6 +201,7 @@ void run_make(const MakeArgs& a) {
                   {"self_slack_m", params.self_slack},
                   {"self_detect_every", params.self_detect_every},
                   {"compression_ratio", params.compression_ratio},
+                  {"compression_pd_ref_m", params.compression_pd_ref},
                   {"clip_start_s", a.start},
                   {"clip_seconds", a.seconds}};
   gdsr::update_manifest_counts(d);
@@ -534,7 +535,7 @@ void add_data_command(CLI::App& app) {
                    "substeps between self-contact detections (default: the solver's)")
       ->check(CLI::Range(1, 1000));
   make->add_option("--compression-ratio", mk->compression_ratio,
-                   "in-plane compression stiffness / stretch stiffness (default: the solver's)")
+                   "in-plane compression stiffness / stretch stiffness at a 10 mm particle distance, scaled by (0.01 m / pd)^2 (default: the solver's)")
       ->check(finite_range(1e-4, 1.0));
   make->add_option("--contact-every", mk->contact_every,
                    "substeps between body contact refreshes (default: the solver's)")

@@ -59,6 +59,10 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     gdsr::fail("sim/cloth_solver", "settle_rest_blend must be in [0, 1]");
   if (!(p.compression_ratio > 0 && p.compression_ratio <= 1))
     gdsr::fail("sim/cloth_solver", "compression_ratio must be in (0, 1]");
+  if (!(p.compression_pd_ref > 0)) gdsr::fail("sim/cloth_solver", "compression_pd_ref must be positive");
+  if (g.particle_distance > 0)
+    p_.compression_ratio =
+        std::min(1.0, p.compression_ratio * std::pow(p.compression_pd_ref / g.particle_distance, 2));
   if (body_F.rows() > 0 && body_F.maxCoeff() >= body_V0.rows())
     gdsr::fail("sim/cloth_solver", "body faces index missing vertices");
   if (!m.V.allFinite()) gdsr::fail("sim/cloth_solver", "garment rest positions are not finite");

@@ -39,13 +39,19 @@ struct SimParams {
   double friction = 0.3;            // Coulomb coefficient against the body
   double density = 0.08;            // kg/m^2 (silk charmeuse ~0.06-0.09)
   double stretch_stiffness = 2000;  // N/m (2-D Young's modulus per edge-area share)
-  double compression_ratio = 0.1;   // stiffness of a shortened edge / stretch_stiffness: woven fabric buckles
-                                    // at scales below the particle distance rather than resisting in-plane
-                                    // compression (Marvelous Designer's "buckling ratio"); at 1 a 30 mm mesh
-                                    // flares out stiffly where a 10 mm one hangs in folds (membrane locking).
-                                    // 5 s of CMU 01_01: 0.01 drapes LR closer to HR (58 against 78 mm) but
-                                    // the 10 mm skirt crumples through itself in the jumps (47% clean frames
-                                    // against 100%)
+  double compression_ratio = 0.1;   // stiffness of a shortened edge / stretch_stiffness at compression_pd_ref:
+                                    // woven fabric buckles at scales below the particle distance rather than
+                                    // resisting in-plane compression (Marvelous Designer's "buckling ratio"); at 1
+                                    // a 30 mm mesh flares out stiffly where a 10 mm one hangs in folds (membrane
+                                    // locking). 5 s of CMU 01_01 at both resolutions: 0.01 drapes LR closer to HR
+                                    // (58 against 78 mm) but the 10 mm skirt crumples through itself in the jumps
+                                    // (47% clean frames against 100%)
+  double compression_pd_ref = 0.01;  // m. At particle distance pd the ratio is compression_ratio * (ref / pd)^2
+                                     // (at most 1): an element cannot buckle inside itself, and the load a sheet of
+                                     // width pd carries before it buckles falls as bending / pd^2 (Euler), so a
+                                     // coarser mesh resists less. 1 s of skirt_short, 30 mm (0.011) against 10 mm
+                                     // (0.1): HR-LR agreement 31.8 -> 22.8 mm on 01_01, 60.6 -> 33.9 mm on salsa
+                                     // 61_02, LR still free of self-intersections
   double bend_stiffness = 2e-6;     // N m (isometric bending modulus; silk is very soft)
   double damping = 0.5;             // 1/s, velocity decay (air drag)
   gdsr::Vec3 gravity = gdsr::Vec3(0, -9.81, 0);  // m/s^2
