@@ -7,7 +7,8 @@
 #   5.   `gdsr infer` + `gdsr eval`: roll-out on the unseen motion, compared with the HR
 #        simulation (vertex error, normal-map SSIM, stretch energies) and a preview PNG;
 #        the report folder runs/demo/report (tables, plots, images, video, glTF / PC2 exports).
-# Outputs go to runs/demo (override with GDSR_DEMO_OUT). Datasets already made are reused.
+# Outputs go to runs/demo (override with GDSR_DEMO_OUT). Datasets already made from the same clip by
+# the same solver revision are reused (data make --skip-built); others are rebuilt.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -19,12 +20,10 @@ mkdir -p "$out"
 "$gdsr" demo
 
 echo "== 3. Paired LR/HR data from our cloth simulator =="
-[ -f "$out/train_skirt_01_01/manifest.json" ] ||
-  "$gdsr" data make --garment skirt_short --motion "$bvh/01_01.bvh" --start 1 --seconds 5 \
-    --out "$out/train_skirt_01_01"
-[ -f "$out/test_skirt_01_03/manifest.json" ] ||
-  "$gdsr" data make --garment skirt_short --motion "$bvh/01_03.bvh" --start 1 --seconds 2 \
-    --out "$out/test_skirt_01_03"
+"$gdsr" data make --skip-built --garment skirt_short --motion "$bvh/01_01.bvh" --start 1 --seconds 5 \
+  --out "$out/train_skirt_01_01"
+"$gdsr" data make --skip-built --garment skirt_short --motion "$bvh/01_03.bvh" --start 1 --seconds 2 \
+  --out "$out/test_skirt_01_03"
 "$gdsr" data preview --data "$out/train_skirt_01_01" --out "$out/data_preview.png"
 
 echo "== 4. Train GDSR (configs/small.json) =="

@@ -63,6 +63,7 @@ struct MakeArgs {
   int iterations = -1, stretch_passes = -1, settle_frames = -1, contact_every = -1, self_detect_every = -1;
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN, self_slack = NAN;
   bool self_collision = true;
+  bool skip_built = false;  // keep --out when it already holds this clip, built and valid
   int rest_blend_frames = 15;
   int raster = 1024;
   int intersection_stride = kDefaultIntersectionStride;
@@ -128,7 +129,17 @@ gdsr::ValidityFigures measure(const gdsr::Dataset& d, const gdsr::ValidityOption
   return v;
 }
 
+bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why);
+
 void run_make(const MakeArgs& a) {
+  if (a.skip_built) {
+    std::string why;
+    if (built_and_valid(a.out, a, why)) {
+      std::printf("kept %s: already built from this clip by this solver revision\n", a.out.c_str());
+      return;
+    }
+    std::printf("building %s (%s)\n", a.out.c_str(), why.c_str());
+  }
   // Everything that can be refused is refused here, before minutes of simulation.
   gdsr::check_dataset_out(a.out);
   if (!(a.hr_pd <= a.lr_pd))
@@ -182,6 +193,7 @@ void run_make(const MakeArgs& a) {
   m.fps = body.fps;
   m.rest_blend_frames = body.rest_blend_frames;
   m.sim_params = {{"solver", "xpbd"},
+                  {"solver_revision", sim::kSolverRevision},
                   {"substeps", params.substeps},
                   {"iterations", params.iterations},
                   {"stretch_passes", params.stretch_passes},
@@ -255,6 +267,10 @@ bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why
         !sp.contains("clip_start_s") || !same(sp["clip_start_s"].get<double>(), a.start) ||
         !sp.contains("clip_seconds") || !same(sp["clip_seconds"].get<double>(), a.seconds) || m.validity.empty()) {
       why = "built from other settings";
+      return false;
+    }
+    if (!sp.contains("solver_revision") || sp["solver_revision"] != sim::kSolverRevision) {
+      why = "built by an older solver";
       return false;
     }
     gdsr::load_dataset(dir);
@@ -544,6 +560,9 @@ void add_data_command(CLI::App& app) {
                    "frames of damped motion on the first pose before frame 0 (default: the solver's)")
       ->check(CLI::Range(0, 1000));
   make->add_flag("!--no-self-collision", mk->self_collision, "switch cloth self-collision off");
+  make->add_flag("--skip-built", mk->skip_built,
+                 "keep --out if it already holds this clip (garment, motion, range, particle distances), built by "
+                 "this solver revision and valid (a recipe always does this)");
   make->add_option("--rest-blend", mk->rest_blend_frames, "frames blending from the rest pose")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));

@@ -31,6 +31,11 @@
 
 namespace sim {
 
+// Bumped whenever a change alters simulated output (solver, garment patterns or placement), so
+// that `gdsr data make --skip-built` and recipes rebuild datasets an older solver made.
+// 2: waist curve, pants yoke, self-contact gap and compression scaled with the particle distance.
+inline constexpr int kSolverRevision = 2;
+
 struct SimParams {
   int substeps = 20;                // per body frame
   int iterations = 2;               // constraint passes per substep (1 pass at 40 substeps is unstable at 10 mm:

@@ -7,6 +7,8 @@
 
 #include <doctest/doctest.h>
 
+#include "gdsr/sim/cloth_solver.hpp"
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -119,6 +121,31 @@ TEST_CASE("cli data: make a tiny dataset, check it and preview a frame") {
                                          (dir / "x") + "'"),
                        "none.bvh");
   check_one_line_error(gdsr_run(dir, "data make --garment no_such_garment --out '" + (dir / "x") + "'"), "garment");
+}
+
+TEST_CASE("cli data: --skip-built keeps a clip built by this solver revision and rebuilds an older one") {
+  TempDir dir("cli_skip_built");
+  const std::string out = dir / "ds";
+  const std::string cmd = "data make --skip-built --garment skirt_short --out '" + out +
+                          "' --seconds 0.1 --lr-pd 0.08 --hr-pd 0.06 --rest-blend 2 --raster 64 --settle-frames 3";
+  const Run first = gdsr_run(dir, cmd);
+  REQUIRE(first.status == 0);
+  CHECK(first.out.find("building") != std::string::npos);
+  const std::string manifest = gdsr_test::slurp(out + "/manifest.json");
+  const std::string rev = "\"solver_revision\": " + std::to_string(sim::kSolverRevision);
+  REQUIRE(manifest.find(rev) != std::string::npos);
+  const Run again = gdsr_run(dir, cmd);
+  REQUIRE(again.status == 0);
+  CHECK(again.out.find("kept") != std::string::npos);
+  // Another clip length, or a dataset an older solver made: rebuilt.
+  const Run longer = gdsr_run(dir, cmd + " --start 0.1");
+  CHECK(longer.out.find("built from other settings") != std::string::npos);
+  std::string old = gdsr_test::slurp(out + "/manifest.json");
+  old.replace(old.find(rev), rev.size(), "\"solver_revision\": 1");
+  std::ofstream(out + "/manifest.json") << old;
+  const Run stale = gdsr_run(dir, cmd + " --start 0.1");
+  REQUIRE(stale.status == 0);
+  CHECK(stale.out.find("built by an older solver") != std::string::npos);
 }
 
 TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out of range are refused") {
