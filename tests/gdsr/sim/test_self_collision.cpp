@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <vector>
 #include <fstream>
 
@@ -69,6 +70,18 @@ sim::Garment two_sheets(double h, int& nl) {
   return g;
 }
 
+// The two sheets at particle distance h with a solver for them (no body, no settle).
+struct TwoSheetDrop {
+  int nl = 0;  // lower sheet's vertex count
+  sim::Garment g;
+  sim::SimParams p;
+  std::unique_ptr<sim::ClothSolver> solver;
+  explicit TwoSheetDrop(double h) : g(two_sheets(h, nl)) {
+    p.settle_frames = 0;
+    solver = std::make_unique<sim::ClothSolver>(g, gdsr::Faces(), Points3(), p);
+  }
+};
+
 }  // namespace
 
 TEST_CASE("self-collision: the CGAL yardstick counts crossing triangles and ignores neighbours") {
@@ -101,11 +114,11 @@ TEST_CASE("self-collision: a sheet dropped onto a clamped sheet lands on it at b
   for (double h : {0.03, 0.015}) {
     CAPTURE(h);
     // The upper sheet falls from 0.3 m and hits the lower one at ~2.4 m/s.
-    int nl = 0;
-    const sim::Garment g = two_sheets(h, nl);
-    sim::SimParams p;
-    p.settle_frames = 0;
-    sim::ClothSolver solver(g, gdsr::Faces(), Points3(), p);
+    TwoSheetDrop d(h);
+    const int nl = d.nl;
+    const sim::Garment& g = d.g;
+    const sim::SimParams& p = d.p;
+    sim::ClothSolver& solver = *d.solver;
     int bad_frames = 0, below = 0;
     long long fall_detections = 0;
     for (int t = 0; t < 24; ++t) {
@@ -189,13 +202,12 @@ TEST_CASE("self-collision: resting layers are kept the larger of the thickness a
   // each upper vertex over the middle to the nearest lower triangle (brute force), median.
   for (double h : {0.03, 0.015}) {
     CAPTURE(h);
-    int nl = 0;
-    const sim::Garment g = two_sheets(h, nl);
-    sim::SimParams p;
-    p.settle_frames = 0;
-    sim::ClothSolver solver(g, gdsr::Faces(), Points3(), p);
-    for (int t = 0; t < 45; ++t) solver.step(Points3(), Points3(), 1.0 / 30);
-    const auto& X = solver.positions();
+    TwoSheetDrop d(h);
+    const int nl = d.nl;
+    for (int t = 0; t < 45; ++t) d.solver->step(Points3(), Points3(), 1.0 / 30);
+    const auto& X = d.solver->positions();
+    const sim::Garment& g = d.g;
+    const sim::SimParams& p = d.p;
     std::vector<double> gaps;
     for (int v = nl; v < X.rows(); ++v) {
       if (std::max(std::abs(X(v, 0)), std::abs(X(v, 2))) > 0.12) continue;
