@@ -298,6 +298,7 @@ void run_recipe(const MakeArgs& a) {
     const gdsr::RecipeClip& c = r.clips[k];
     MakeArgs one = a;
     one.recipe.clear();
+    one.skip_built = false;  // checked just below
     one.garment = c.garment;
     one.motion = c.motion;
     one.start = c.start;

@@ -290,21 +290,11 @@ double waist_radius(const BodyLandmarks& lm, double psi) {
   return (1 - a) * lm.waist_profile[i] + a * lm.waist_profile[(i + 1) % n];
 }
 
-namespace {
-// Metres under the waist over which a waist fit fades out (see WaistCurve::weight).
-double waist_fit_drop(const BodyLandmarks& lm) {
-  return std::min(0.1 * lm.height / 1.75, 0.7 * std::max(lm.waist_y - lm.hip_y, 0.0));
-}
-// Fraction of a waist fit applied `below` metres under the waist: smoothstep from 1 to 0 over `drop`.
-double waist_fit_weight(double drop, double below) {
-  if (!(drop > 0)) return below <= 0 ? 1.0 : 0.0;
-  const double t = std::clamp(below / drop, 0.0, 1.0);
-  return 1 - t * t * (3 - 2 * t);
-}
-}  // namespace
-
 double waist_fit_shrink(const BodyLandmarks& lm, double psi, double below) {
-  return (lm.waist_r - waist_radius(lm, psi)) * waist_fit_weight(waist_fit_drop(lm), below);
+  const double drop = std::min(0.1 * lm.height / 1.75, 0.7 * std::max(lm.waist_y - lm.hip_y, 0.0));
+  if (!(drop > 0)) return 0;
+  const double t = std::clamp(below / drop, 0.0, 1.0);
+  return (lm.waist_r - waist_radius(lm, psi)) * (1 - t * t * (3 - 2 * t));
 }
 
 namespace {

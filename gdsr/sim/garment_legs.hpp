@@ -48,16 +48,19 @@ inline LegCoords leg_coords(int panel, const gdsr::Vec2& uv, double W, double R,
 
 // The two panels `prefix`_front and `prefix`_back (laid W + 0.1 apart, as leg_coords
 // expects): width W, height Htot, crotch Hc above the hem, gusset half-width g at the hem;
-// side seams and inseams.
-inline void add_two_leg_panels(Pattern& p, double W, double Htot, double Hc, double g, const std::string& prefix) {
-  std::vector<gdsr::Vec2> o{gdsr::Vec2(-W / 2, 0), gdsr::Vec2(-g, 0),       gdsr::Vec2(0, Hc),
-                            gdsr::Vec2(g, 0),      gdsr::Vec2(W / 2, 0),    gdsr::Vec2(W / 2, Htot),
-                            gdsr::Vec2(-W / 2, Htot)};
+// side seams and inseams. Edges: hem, inseams, hem (0-3), side up (4), top from +x to -x split
+// into n_top equal edges (5 .. 4 + n_top, to sew another panel on), side down (5 + n_top).
+inline void add_two_leg_panels(Pattern& p, double W, double Htot, double Hc, double g, const std::string& prefix,
+                               int n_top = 1) {
+  std::vector<gdsr::Vec2> o{gdsr::Vec2(-W / 2, 0), gdsr::Vec2(-g, 0), gdsr::Vec2(0, Hc), gdsr::Vec2(g, 0),
+                            gdsr::Vec2(W / 2, 0)};
+  for (int i = 0; i < n_top; ++i) o.push_back(gdsr::Vec2(W / 2 - W * i / n_top, Htot));
+  o.push_back(gdsr::Vec2(-W / 2, Htot));
   p.panels.push_back({prefix + "_front", o});
   for (auto& v : o) v.x() += W + 0.1;
   p.panels.push_back({prefix + "_back", o});
-  p.seams.push_back({0, 4, 1, 6, true});  // side seams
-  p.seams.push_back({1, 4, 0, 6, true});
+  p.seams.push_back({0, 4, 1, 5 + n_top, true});  // side seams
+  p.seams.push_back({1, 4, 0, 5 + n_top, true});
   p.seams.push_back({0, 1, 1, 2, true});  // inseams
   p.seams.push_back({0, 2, 1, 1, true});
 }

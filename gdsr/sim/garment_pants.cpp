@@ -43,21 +43,9 @@ GarmentDesign design_pants(const BodyLandmarks& lm) {
   const double ease = 0.015 * s;
   const double a = waist_perimeter(lm, ease) / (2 * kPi);
   const Cone yoke(a, std::max(R, a + 0.01 * s), Htot - Ht);
-  // Leg panels up to the hip line, whose edge is split like the yoke's lower arc. Outline:
-  // hem, inseams, hem (edges 0-3), side seam up (4), hip line from +x to -x (5 .. 4 + n),
-  // side seam down (5 + n).
+  // Leg panels up to the hip line, whose edge is split like the yoke's lower arc (edges 5 .. 4 + n).
   const int n = std::max(8, static_cast<int>(std::ceil(kPi * yoke.b / 0.03)));
-  for (int panel = 0; panel < 2; ++panel) {
-    std::vector<Vec2> o{Vec2(-W / 2, 0), Vec2(-g, 0), Vec2(0, Hc), Vec2(g, 0), Vec2(W / 2, 0)};
-    for (int i = 0; i < n; ++i) o.push_back(Vec2(W / 2 - W * i / n, Ht));
-    o.push_back(Vec2(-W / 2, Ht));
-    for (auto& v : o) v.x() += panel * (W + 0.1);
-    p.panels.push_back({panel == 0 ? "pants_front" : "pants_back", o});
-  }
-  p.seams.push_back({0, 4, 1, 5 + n, true});  // side seams
-  p.seams.push_back({1, 4, 0, 5 + n, true});
-  p.seams.push_back({0, 1, 1, 2, true});  // inseams
-  p.seams.push_back({0, 2, 1, 1, true});
+  add_two_leg_panels(p, W, Ht, Hc, g, "pants", n);
   // The yoke (panels 2, 3): its lower arc's edge j (psi increasing) meets hip-line edge n - 1 - j.
   auto lay = std::make_shared<SkirtLayout>(add_cone_skirt(p, yoke, pattern_max_x(p) + 0.1, "pants_yoke", 0, {}, n));
   for (int k = 0; k < 2; ++k)
