@@ -85,11 +85,14 @@ template <class T> void linear_backward(Node<T>& xn, Node<T>& wn, Node<T>* bn, c
       for (int64_t o = 0; o < O; ++o) gb[o] += g[r * O + o];
   }
 }
-// Y += X W^T in row blocks (Y is a fresh, zeroed output).
-template <class T> void gemm_xwt(const Tensor<T>& x, const Tensor<T>& weight, MatMap<T>& Y) {
+// Y += X W^T in tiles (Y is a fresh, zeroed output), then epilogue(r0, r1, c0, c1) on each
+// tile while it is still in cache (bias, activation): one pass over Y instead of two.
+template <class T, class Epilogue>
+void gemm_xwt(const Tensor<T>& x, const Tensor<T>& weight, MatMap<T>& Y, Epilogue epilogue) {
   const ConstMatMap<T> X = x.mat(), W = weight.mat();
   tiles(X.rows(), W.rows(), X.cols(), [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
     Y.block(r0, c0, r1 - r0, c1 - c0).noalias() += X.middleRows(r0, r1 - r0) * W.middleRows(c0, c1 - c0).transpose();
+    epilogue(r0, r1, c0, c1);
   });
 }
 }  // namespace
@@ -100,11 +103,14 @@ template <class T> Tensor<T> linear(const Tensor<T>& x, const Tensor<T>& weight,
   const int64_t out_f = weight.rows();
   Tensor<T> out = new_output<T>({x.rows(), out_f});
   MatMap<T> Y = out.mat();
-  gemm_xwt(x, weight, Y);
-  if (bias.defined()) {
-    Eigen::Map<const Eigen::Matrix<T, 1, Eigen::Dynamic>> bv(bias.data(), out_f);
-    Y.rowwise() += bv;
-  }
+  const T* b = bias.defined() ? bias.data() : nullptr;
+  gemm_xwt(x, weight, Y, [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
+    if (!b) return;
+    for (int64_t r = r0; r < r1; ++r) {
+      T* yr = Y.data() + r * out_f;
+      for (int64_t c = c0; c < c1; ++c) yr[c] += b[c];
+    }
+  });
   std::vector<std::shared_ptr<NodeBase>> parents{x.node_ptr(), weight.node_ptr()};
   if (bias.defined()) parents.push_back(bias.node_ptr());
   record(out.node(), std::move(parents),
@@ -121,25 +127,20 @@ Tensor<T> linear_leaky_relu(const Tensor<T>& x, const Tensor<T>& weight, const T
   if (!(slope > 0)) throw Error("linear_leaky_relu: slope must be > 0, got " + std::to_string(slope));
   const int64_t N = x.rows(), out_f = weight.rows();
   Tensor<T> out = new_output<T>({N, out_f});
-  {
-    MatMap<T> Y = out.mat();
-    gemm_xwt(x, weight, Y);
-  }
-  {
-    T* y = out.data();
-    const T* b = bias.defined() ? bias.data() : nullptr;
-#pragma omp parallel for firstprivate(slope) if (N * out_f > kParallelMin)
-    for (int64_t r = 0; r < N; ++r) {
-      T* yr = y + r * out_f;
+  MatMap<T> Y = out.mat();
+  const T* b = bias.defined() ? bias.data() : nullptr;
+  gemm_xwt(x, weight, Y, [&, slope](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
+    for (int64_t r = r0; r < r1; ++r) {
+      T* yr = Y.data() + r * out_f;
       if (b)
-        for (int64_t c = 0; c < out_f; ++c) {
+        for (int64_t c = c0; c < c1; ++c) {
           const T v = yr[c] + b[c];
           yr[c] = v > 0 ? v : slope * v;
         }
       else
-        for (int64_t c = 0; c < out_f; ++c) yr[c] = yr[c] > 0 ? yr[c] : slope * yr[c];
+        for (int64_t c = c0; c < c1; ++c) yr[c] = yr[c] > 0 ? yr[c] : slope * yr[c];
     }
-  }
+  });
   std::vector<std::shared_ptr<NodeBase>> parents{x.node_ptr(), weight.node_ptr()};
   if (bias.defined()) parents.push_back(bias.node_ptr());
   record(out.node(), std::move(parents),

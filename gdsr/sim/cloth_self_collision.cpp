@@ -7,7 +7,9 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <exception>
 #include <map>
 #include <mutex>
 #include <stdexcept>
@@ -107,6 +109,33 @@ void sort_unique_pairs(std::vector<P>& v, int n, Key0 key0, Key1 key1) {
   v.swap(out);
 }
 
+// Squared distance between the boxes [lo1, hi1] and [lo2, hi2]: a lower bound of the
+// squared distance between anything inside them, to skip the exact test for pairs clearly
+// too far apart (HR skirt on CMU 61_02: 1.03 -> 0.92 s per frame, output unchanged).
+// kGapMargin keeps rounding from skipping a pair the exact test would keep.
+double box_gap2(const Vec3& lo1, const Vec3& hi1, const Vec3& lo2, const Vec3& hi2) {
+  double g2 = 0;
+  for (int c = 0; c < 3; ++c) {
+    const double g = std::max({0.0, lo2[c] - hi1[c], lo1[c] - hi2[c]});
+    g2 += g * g;
+  }
+  return g2;
+}
+constexpr double kGapMargin = 1 + 1e-9;
+
+// Uncontended in practice (Embree's device runs one thread per call): an atomic flag.
+class SpinLock {
+ public:
+  void lock() {
+    while (flag_.test_and_set(std::memory_order_acquire)) {
+    }
+  }
+  void unlock() { flag_.clear(std::memory_order_release); }
+
+ private:
+  std::atomic_flag flag_ = ATOMIC_FLAG_INIT;
+};
+
 constexpr double kInside = -1e-3;  // barycentric tolerance: a vertex on a shared edge is guarded by both faces
 constexpr double kEdgeEnd = 1e-3;  // edge parameter tolerance for an interior edge-edge closest point
 
@@ -121,8 +150,6 @@ struct SelfCollision::Embree {
   const Points3* motion = nullptr;  // null: boxes of the current positions only
   double pad = 0;
   const SelfCollision* owner = nullptr;
-  std::mutex mutex;
-  std::vector<std::pair<int, int>> pairs;
   ~Embree() {
     if (device) rtcReleaseDevice(device);
   }
@@ -157,16 +184,21 @@ struct SelfCollision::Embree {
   }
   // Box overlaps (primID0, primID1) between two scenes of the given kinds (0 vertices,
   // 1 edges, 2 faces) whose primitives share no vertex, each unordered pair once, in no
-  // particular order.
-  int kind0 = 0, kind1 = 0;
-  bool adjacent(int a, int b) const {
-    int ia[3], ib[3];
-    const int na = ids(kind0, a, ia), nb = ids(kind1, b, ib);
-    for (int i = 0; i < na; ++i)
-      for (int j = 0; j < nb; ++j)
-        if (ia[i] == ib[j]) return true;
-    return false;
-  }
+  // particular order. Two collides may run at once (each has its own Overlaps).
+  struct Overlaps {
+    const Embree* e;
+    int kind0, kind1;
+    SpinLock mutex;  // in case Embree calls back from several threads (a pthread mutex was 4% of a simulation)
+    std::vector<std::pair<int, int>> pairs;
+    bool adjacent(int a, int b) const {
+      int ia[3], ib[3];
+      const int na = e->ids(kind0, a, ia), nb = e->ids(kind1, b, ib);
+      for (int i = 0; i < na; ++i)
+        for (int j = 0; j < nb; ++j)
+          if (ia[i] == ib[j]) return true;
+      return false;
+    }
+  };
   int ids(int kind, int p, int* out) const {
     if (kind == 0) {
       out[0] = p;
@@ -179,34 +211,32 @@ struct SelfCollision::Embree {
     for (int k = 0; k < 3; ++k) out[k] = owner->F_(p, k);
     return 3;
   }
-  std::vector<std::pair<int, int>> collide(RTCScene a, int ka, RTCScene b, int kb) {
-    pairs.clear();
-    kind0 = ka;
-    kind1 = kb;
+  std::vector<std::pair<int, int>> collide(RTCScene a, int ka, RTCScene b, int kb) const {
+    Overlaps o{this, ka, kb, {}, {}};
     rtcCollide(
         a, b,
         [](void* user, RTCCollision* c, unsigned int n) {
-          auto* e = static_cast<Embree*>(user);
-          const bool self = e->kind0 == e->kind1;
+          auto* o = static_cast<Overlaps*>(user);
+          const bool self = o->kind0 == o->kind1;
           std::pair<int, int> keep[256];
           int nk = 0;
           for (unsigned k = 0; k < n; ++k) {
             const int p = static_cast<int>(c[k].primID0), q = static_cast<int>(c[k].primID1);
-            if ((self && p >= q) || e->adjacent(p, q)) continue;
+            if ((self && p >= q) || o->adjacent(p, q)) continue;
             if (nk == 256) {
-              std::lock_guard<std::mutex> lock(e->mutex);
-              e->pairs.insert(e->pairs.end(), keep, keep + nk);
+              std::lock_guard<SpinLock> lock(o->mutex);
+              o->pairs.insert(o->pairs.end(), keep, keep + nk);
               nk = 0;
             }
             keep[nk++] = {p, q};
           }
-          std::lock_guard<std::mutex> lock(e->mutex);
-          e->pairs.insert(e->pairs.end(), keep, keep + nk);
+          std::lock_guard<SpinLock> lock(o->mutex);
+          o->pairs.insert(o->pairs.end(), keep, keep + nk);
         },
-        this);
+        &o);
     const RTCError err = rtcGetDeviceError(device);
     if (err != RTC_ERROR_NONE) fail("Embree collide failed (error " + std::to_string(static_cast<int>(err)) + ")");
-    return std::move(pairs);  // in callback order: the caller sorts what it keeps
+    return std::move(o.pairs);  // in callback order: the caller sorts what it keeps
   }
 };
 
@@ -278,16 +308,35 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
   };
   std::vector<std::pair<int, int>> vf, ee, ef;
   {
+    // Vertex-face and edge-edge overlaps on two threads: Embree's device runs one thread
+    // per call, and the broad phase was half of a detection.
     ScenesGuard g;
-    g.s[0] = E.scene(nv, [](const RTCBoundsFunctionArguments* a) {
-      const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
-      const int v = static_cast<int>(a->primID);
-      e->bounds(&v, 1, a->bounds_o);
-    });
-    g.s[1] = edge_scene();
-    g.s[2] = face_scene();
-    vf = E.collide(g.s[0], 0, g.s[2], 2);
-    ee = E.collide(g.s[1], 1, g.s[1], 1);
+    std::exception_ptr error;
+#pragma omp parallel sections num_threads(2)
+    {
+#pragma omp section
+      try {
+        g.s[0] = E.scene(nv, [](const RTCBoundsFunctionArguments* a) {
+          const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
+          const int v = static_cast<int>(a->primID);
+          e->bounds(&v, 1, a->bounds_o);
+        });
+        g.s[2] = face_scene();
+        vf = E.collide(g.s[0], 0, g.s[2], 2);
+      } catch (...) {
+#pragma omp critical(self_collision_error)
+        error = std::current_exception();
+      }
+#pragma omp section
+      try {
+        g.s[1] = edge_scene();
+        ee = E.collide(g.s[1], 1, g.s[1], 1);
+      } catch (...) {
+#pragma omp critical(self_collision_error)
+        error = std::current_exception();
+      }
+    }
+    if (error) std::rethrow_exception(error);
   }
   if (tangle_test) {
     // An edge crossing a face now: tight boxes of the current positions (the swept, padded
@@ -312,33 +361,38 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     for (int k = 0; k < nvf; ++k) {
       const int v = vf[k].first, g = vf[k].second;
       const Vec3 p = x.row(v), a = x.row(F_(g, 0)), b = x.row(F_(g, 1)), c = x.row(F_(g, 2));
-      const double d = (p - gdsr::closest_point_on_triangle(p, a, b, c).point).norm();
       // Relative motion of the vertex against any point of the triangle is bounded by the
       // largest against its corners; each side may also leave its path by `slack`.
-      double rel = 0;
-      for (int i = 0; i < 3; ++i) rel = std::max(rel, (motion.row(v) - motion.row(F_(g, i))).norm());
-      if (d >= thickness + rel + 2 * slack) continue;
+      double rel2 = 0;
+      for (int i = 0; i < 3; ++i) rel2 = std::max(rel2, (motion.row(v) - motion.row(F_(g, i))).squaredNorm());
+      const double rel = std::sqrt(rel2), reach = thickness + rel + 2 * slack;
+      if (box_gap2(p, p, a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c)) > reach * reach * kGapMargin) continue;
+      const double d = (p - gdsr::closest_point_on_triangle(p, a, b, c).point).norm();
+      if (d >= reach) continue;
       Vec3 bary, n;
       double dist = 0;
       if (!project_on_triangle(p, a, b, c, bary, n, dist)) continue;
       vt_keep[k] = dist >= 0 ? 1 : -1;
-      vt_reach[k] = static_cast<float>(thickness + rel + 2 * slack);
+      vt_reach[k] = static_cast<float>(reach);
     }
 #pragma omp for schedule(static) nowait
     for (int k = 0; k < nee; ++k) {
       const int ea = ee[k].first, eb = ee[k].second;
       const int i0 = edges_[ea][0], i1 = edges_[ea][1], j0 = edges_[eb][0], j1 = edges_[eb][1];
       const Vec3 p1 = x.row(i0), q1 = x.row(i1), p2 = x.row(j0), q2 = x.row(j1);
+      double rel2 = 0;
+      for (int u : edges_[ea])
+        for (int w : edges_[eb]) rel2 = std::max(rel2, (motion.row(u) - motion.row(w)).squaredNorm());
+      const double rel = std::sqrt(rel2), reach = thickness + rel + 2 * slack;
+      if (box_gap2(p1.cwiseMin(q1), p1.cwiseMax(q1), p2.cwiseMin(q2), p2.cwiseMax(q2)) > reach * reach * kGapMargin)
+        continue;
       double s = 0, t = 0;
       closest_segments(p1, q1, p2, q2, s, t);
       const Vec3 d = (p1 + s * (q1 - p1)) - (p2 + t * (q2 - p2));
-      double rel = 0;
-      for (int u : edges_[ea])
-        for (int w : edges_[eb]) rel = std::max(rel, (motion.row(u) - motion.row(w)).norm());
       const double len = d.norm();
-      if (len >= thickness + rel + 2 * slack) continue;
+      if (len >= reach) continue;
       ee_keep[k] = 1;
-      ee_reach[k] = static_cast<float>(thickness + rel + 2 * slack);
+      ee_reach[k] = static_cast<float>(reach);
       const Vec3 u = len > 0 ? Vec3(d / len) : Vec3::Zero();
       ee_dir[k] = {static_cast<float>(u.x()), static_cast<float>(u.y()), static_cast<float>(u.z())};
     }
@@ -354,8 +408,13 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     if (vt_keep[k]) vt_.push_back({vf[k].first, vf[k].second, vt_keep[k], vt_reach[k]});
   for (int k = 0; k < nee; ++k)
     if (ee_keep[k]) ee_.push_back({ee[k].first, ee[k].second, {ee_dir[k][0], ee_dir[k][1], ee_dir[k][2]}, ee_reach[k]});
-  sort_unique_pairs(vt_, nv, [](const VT& c) { return c.v; }, [](const VT& c) { return c.f; });
-  sort_unique_pairs(ee_, ne, [](const EE& c) { return c.a; }, [](const EE& c) { return c.b; });
+#pragma omp parallel sections num_threads(2)
+  {
+#pragma omp section
+    sort_unique_pairs(vt_, nv, [](const VT& c) { return c.v; }, [](const VT& c) { return c.f; });
+#pragma omp section
+    sort_unique_pairs(ee_, ne, [](const EE& c) { return c.a; }, [](const EE& c) { return c.b; });
+  }
   for (int k = 0; k < nef; ++k)
     if (ef_cross[k]) {
       ++intersecting_;
