@@ -60,6 +60,7 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
   if (!(p.compression_ratio > 0 && p.compression_ratio <= 1))
     gdsr::fail("sim/cloth_solver", "compression_ratio must be in (0, 1]");
   if (!(p.compression_pd_ref > 0)) gdsr::fail("sim/cloth_solver", "compression_pd_ref must be positive");
+  if (!(p.contact_release_stretch > 1)) gdsr::fail("sim/cloth_solver", "contact_release_stretch must be > 1");
   if (g.particle_distance > 0)
     p_.compression_ratio =
         std::min(1.0, p.compression_ratio * std::pow(p.compression_pd_ref / g.particle_distance, 2));
@@ -124,6 +125,16 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     const double A = uv_area(m, f0) + uv_area(m, f1);
     Bend b{{x0, x1, x2, x3}, {c03 + c04, c01 + c02, -c01 - c03, -c02 - c04}, A / p.bend_stiffness};
     bends_.push_back(b);
+  }
+
+  vertex_edge_start_.assign(m.V.rows() + 1, 0);
+  for (const Edge& e : edges_) ++vertex_edge_start_[e.i + 1], ++vertex_edge_start_[e.j + 1];
+  for (int v = 0; v < m.V.rows(); ++v) vertex_edge_start_[v + 1] += vertex_edge_start_[v];
+  vertex_edges_.resize(vertex_edge_start_.back());
+  {
+    std::vector<int> fill(vertex_edge_start_.begin(), vertex_edge_start_.end() - 1);
+    for (int e = 0; e < static_cast<int>(edges_.size()); ++e)
+      vertex_edges_[fill[edges_[e].i]++] = e, vertex_edges_[fill[edges_[e].j]++] = e;
   }
 
   // Body grid for the rest pose; initial push-out; pins.
@@ -406,6 +417,17 @@ void ClothSolver::solve_layers() {
   }
 }
 
+bool ClothSolver::overstretched_at(int v, const Vec3& x) const {
+  const double limit = p_.contact_release_stretch;
+  for (int k = vertex_edge_start_[v]; k < vertex_edge_start_[v + 1]; ++k) {
+    const Edge& e = edges_[vertex_edges_[k]];
+    const Vec3 other = x_.row(e.i == v ? e.j : e.i).transpose();
+    const double now = (x - other).norm(), before = (x_.row(v).transpose() - other).norm();
+    if (now > limit * e.rest && now > before) return true;
+  }
+  return false;
+}
+
 void ClothSolver::solve_body_contacts(const Points3& body_prev, const Points3& body_now) {
   for (const auto& c : contacts_) {
     const Vec3 q = bary_point(body_now, bodyF_, c.face, c.bary);
@@ -414,6 +436,7 @@ void ClothSolver::solve_body_contacts(const Points3& body_prev, const Points3& b
     const double C = (x - q).dot(nrm) - p_.thickness;
     if (C >= 0) continue;
     x -= C * nrm;
+    if (overstretched_at(c.v, x)) continue;
     // Coulomb friction on the displacement relative to the body point this substep.
     const Vec3 qprev = bary_point(body_prev, bodyF_, c.face, c.bary);
     Vec3 rel = (x - xprev_.row(c.v).transpose()) - (q - qprev);

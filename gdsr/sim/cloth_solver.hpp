@@ -34,7 +34,8 @@ namespace sim {
 // Bumped whenever a change alters simulated output (solver, garment patterns or placement), so
 // that `gdsr data make --skip-built` and recipes rebuild datasets an older solver made.
 // 2: waist curve, pants yoke, self-contact gap and compression scaled with the particle distance.
-inline constexpr int kSolverRevision = 2;
+// 3: body contacts give way rather than overstretch the cloth (contact_release_stretch).
+inline constexpr int kSolverRevision = 3;
 
 struct SimParams {
   int substeps = 20;                // per body frame
@@ -64,6 +65,10 @@ struct SimParams {
   double contact_radius = 0.03;                  // m, body search radius beyond thickness
   int contact_every = 5;                         // substeps between contact refreshes
   double max_push = 0.02;                        // m, vertices deeper than this inside the body are not pushed out
+  double contact_release_stretch = 1.5;  // a body contact whose push would leave an edge of the vertex longer than this
+                                         // times its rest length (and longer than before) lets the cloth slip instead:
+                                         // a hand sweeping past a pinned waistband (CMU salsa 61_02) otherwise dragged
+                                         // one vertex 23 cm out of the skirt, its edges 20x their length
   double pinch_separation = 0.15;  // m: body points this far apart in the first pose are different parts (a hand
                                    // and a hip); cloth pinched between two parts stays on the part it was dressed on
   double max_speed = 15;                         // m/s, velocity clamp (safety against fast body parts)
@@ -142,6 +147,7 @@ class ClothSolver {
   void solve_bends(std::vector<double>& lambda, double h2);
   void solve_layers();
   void solve_body_contacts(const gdsr::Points3& body_prev, const gdsr::Points3& body_now);
+  bool overstretched_at(int v, const gdsr::Vec3& x) const;  // see SimParams::contact_release_stretch
   void solve_self_contacts();
   void update_velocities(double h);
   void track_self_slack();
@@ -152,6 +158,7 @@ class ClothSolver {
   gdsr::Points3 x_, v_, xprev_;
   std::vector<double> mass_, winv_;
   std::vector<Edge> edges_;
+  std::vector<int> vertex_edge_start_, vertex_edges_;  // edges of vertex v: vertex_edges_[start[v] .. start[v + 1])
   std::vector<double> edge_rest_placed_, edge_rest_pattern_;  // m, per edge
   std::vector<double> tether_rest_placed_, tether_rest_pattern_;  // m, per tether (placed: not below the pattern)
   std::vector<double> edge_scale_;  // per edge, this substep: compliance factor (1 stretched, 1/compression_ratio)
