@@ -107,6 +107,12 @@ void run_train(TrainArgs& a, const gdsr::MpiRanks& mpi) {
                   L.fine, L.lr, L.seconds);
       std::fflush(stdout);
     }
+    if (L.validated) {
+      std::fprintf(stderr, "\n");
+      std::printf("validation at step %lld: loss %.5g; vertex error %.2f mm (upsampled LR %.2f mm) on the patches\n",
+                  static_cast<long long>(L.step), L.val_loss, L.val_vertex_mm, L.val_upsample_mm);
+      std::fflush(stdout);
+    }
   });
   if (!writer) return;
   bar.finish();

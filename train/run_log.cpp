@@ -60,7 +60,8 @@ const std::vector<std::string>& RunLog::columns() {
   static const std::vector<std::string> c = {
       "step",       "epoch",    "loss",       "coarse",   "fine",      "c_position", "c_normal", "c_strain",
       "c_smooth",   "c_dihedral", "f_position", "f_vgg",  "f_image_l1", "f_strain",  "f_smooth", "lr",
-      "lambda_c",   "lambda_w", "grad_norm",  "seconds",  "val_loss",  "val_coarse", "val_fine"};
+      "lambda_c",   "lambda_w", "grad_norm",  "seconds",  "val_loss",  "val_coarse", "val_fine",
+      "val_vertex_mm", "val_upsample_mm"};
   return c;
 }
 
@@ -88,9 +89,10 @@ std::string row(const TrainLog& L) {
   r += "," + num(L.lr) + "," + num(L.lambda_c) + "," + num(L.lambda_w) + "," + num(L.grad_norm) + "," +
        num(L.seconds);
   if (L.validated)
-    r += "," + num(L.val_loss) + "," + num(L.val_coarse) + "," + num(L.val_fine);
+    r += "," + num(L.val_loss) + "," + num(L.val_coarse) + "," + num(L.val_fine) + "," + num(L.val_vertex_mm) + "," +
+         num(L.val_upsample_mm);
   else
-    r += ",,,";
+    r += ",,,,,";
   return r;
 }
 

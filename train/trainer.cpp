@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -188,7 +189,17 @@ struct FrameLoss {
   ag::Tensorf total;
   double coarse = 0, fine = 0;          // weighted parts
   std::map<std::string, double> terms;  // unweighted
+  double vertex_m = 0, upsample_m = 0;  // validation only: mean |G - HR| and |upsampled LR - HR| on the patches
 };
+
+// Mean distance, metres, between rows `vertices` of `truth` and the rows of `predicted`
+// (predicted row i is vertex vertices[i]; `all`: predicted holds every vertex).
+double mean_distance_at(const Points3& predicted, const Points3& truth, const std::vector<int>& vertices, bool all) {
+  double sum = 0;
+  for (size_t i = 0; i < vertices.size(); ++i)
+    sum += (predicted.row(all ? vertices[i] : static_cast<int>(i)) - truth.row(vertices[i])).norm();
+  return vertices.empty() ? 0.0 : sum / static_cast<double>(vertices.size());
+}
 
 // Forward and losses of frame t of a sequence (noise and rng: training draws; nullptr noise
 // for validation).
@@ -212,6 +223,10 @@ FrameLoss frame_loss(TrainState& s, Sequence& seq, int t, const Lambdas& lambdas
   f.fine = fine.total.defined() ? lambdas.fine * fine.total.item() : 0.0;
   f.terms = coarse.log();                   // keys c_position, c_normal, ...
   if (opt.fine) f.terms.merge(fine.log());  // f_position, f_vgg, ...
+  if (opt.fine && !noise) {
+    f.vertex_m = mean_distance_at(gdsr::to_points(out.G), d.hr_frames[t], batch.vertices, false);
+    f.upsample_m = mean_distance_at(upsample(d.corr, d.lr_frames[t]), d.hr_frames[t], batch.vertices, true);
+  }
   return f;
 }
 
@@ -379,7 +394,7 @@ void validate(TrainState& s, TrainLog& L, const TrainOptions& opt) {
   ag::NoGradGuard no_grad;
   std::mt19937_64 rng(opt.seed + 0x5eed);
   const Lambdas lambdas = opt.loss.schedule ? lambda_schedule(opt.loss, L.epoch) : Lambdas{1, 1};
-  double total = 0, coarse = 0, fine = 0;
+  double total = 0, coarse = 0, fine = 0, vertex = 0, upsampled = 0;
   int n = 0;
   for (Sequence& seq : s.val)
     for (int t = 2; t < static_cast<int>(seq.d->lr_frames.size()); ++t, ++n) {
@@ -387,11 +402,16 @@ void validate(TrainState& s, TrainLog& L, const TrainOptions& opt) {
       total += f.total.item();
       coarse += f.coarse;
       fine += f.fine;
+      vertex += f.vertex_m;
+      upsampled += f.upsample_m;
     }
   L.validated = true;
   L.val_loss = total / n;
   L.val_coarse = coarse / n;
   L.val_fine = fine / n;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  L.val_vertex_mm = opt.fine ? 1000 * vertex / n : nan;
+  L.val_upsample_mm = opt.fine ? 1000 * upsampled / n : nan;
 }
 
 void check_finite_parameters(const TrainState& s) {

@@ -73,6 +73,9 @@ struct TrainLog {
   bool checkpointed = false;            // a checkpoint was written after this step
   bool validated = false;               // val_* hold the validation figures of this step
   double val_loss = 0, val_coarse = 0, val_fine = 0;  // means over the validation frames
+  // mm, mean over the validation frames' patch vertices of |G - HR| (one-step prediction) and, as the
+  // yardstick, of |upsampled LR input - HR| at the same vertices; NaN without patches (--no-fine)
+  double val_vertex_mm = 0, val_upsample_mm = 0;
 };
 
 struct TrainResult {

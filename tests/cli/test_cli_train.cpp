@@ -138,6 +138,12 @@ TEST_CASE("cli train: the run folder holds the CSV log and loss curves and confi
     CHECK(header.find(c) != std::string::npos);
   CHECK(!column(rows[2], 20).empty());  // step 3: a checkpoint, validated
   CHECK(column(rows[3], 20).empty());
+  // vertex error of the one-step prediction and of the upsampled LR input, mm, on the patches
+  CHECK(header.find("val_vertex_mm,val_upsample_mm") != std::string::npos);
+  CHECK(std::stod(column(rows[2], 23)) > 0);
+  CHECK(std::stod(column(rows[2], 24)) > 0);
+  CHECK(column(rows[3], 23).empty());
+  CHECK(r.out.find("validation at step 3: loss") != std::string::npos);
   CHECK(std::stod(column(rows[0], 18)) > 0);  // gradient norm
   CHECK(fs::file_size(out + "/loss_curves.png") > 5000);
   CHECK(fs::exists(out + "/model.best.ckpt"));
