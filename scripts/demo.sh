@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The main job on the built-in default data, start to end (about 7 minutes on 2 cores):
+# The main job on the built-in default data, start to end (about 6 minutes on 2 cores):
 #   1-2. `gdsr demo`: our autograd trains a small MLP; gradient-check summary of every op;
 #   3.   paired LR (30 mm) / HR (10 mm) skirt simulations with our cloth solver on CMU
 #        motion capture: clip 01_01 for training, 01_03 (unseen motion) for testing;
