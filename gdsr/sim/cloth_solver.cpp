@@ -127,15 +127,14 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     bends_.push_back(b);
   }
 
-  vertex_edge_start_.assign(m.V.rows() + 1, 0);
-  for (const Edge& e : edges_) ++vertex_edge_start_[e.i + 1], ++vertex_edge_start_[e.j + 1];
-  for (int v = 0; v < m.V.rows(); ++v) vertex_edge_start_[v + 1] += vertex_edge_start_[v];
-  vertex_edges_.resize(vertex_edge_start_.back());
-  {
-    std::vector<int> fill(vertex_edge_start_.begin(), vertex_edge_start_.end() - 1);
-    for (int e = 0; e < static_cast<int>(edges_.size()); ++e)
-      vertex_edges_[fill[edges_[e].i]++] = e, vertex_edges_[fill[edges_[e].j]++] = e;
-  }
+  std::vector<int>& start = vertex_edges_.offsets;
+  start.assign(m.V.rows() + 1, 0);
+  for (const Edge& e : edges_) ++start[e.i + 1], ++start[e.j + 1];
+  for (int v = 0; v < m.V.rows(); ++v) start[v + 1] += start[v];
+  vertex_edges_.items.resize(start.back());
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  for (int e = 0; e < static_cast<int>(edges_.size()); ++e)
+    vertex_edges_.items[fill[edges_[e].i]++] = e, vertex_edges_.items[fill[edges_[e].j]++] = e;
 
   // Body grid for the rest pose; initial push-out; pins.
   const double cell = std::max(0.05, p.contact_radius + p.thickness);
@@ -419,8 +418,8 @@ void ClothSolver::solve_layers() {
 
 bool ClothSolver::overstretched_at(int v, const Vec3& x) const {
   const double limit = p_.contact_release_stretch;
-  for (int k = vertex_edge_start_[v]; k < vertex_edge_start_[v + 1]; ++k) {
-    const Edge& e = edges_[vertex_edges_[k]];
+  for (int k = vertex_edges_.offsets[v]; k < vertex_edges_.offsets[v + 1]; ++k) {
+    const Edge& e = edges_[vertex_edges_.items[k]];
     const Vec3 other = x_.row(e.i == v ? e.j : e.i).transpose();
     const double now = (x - other).norm(), before = (x_.row(v).transpose() - other).norm();
     if (now > limit * e.rest && now > before) return true;

@@ -17,6 +17,7 @@
 
 #include "gdsr/body/body.hpp"
 #include "gdsr/geometry/mesh.hpp"
+#include "gdsr/geometry/mesh_ops.hpp"
 #include "gdsr/io/progress.hpp"
 #include "gdsr/sim/cloth_bending_solve.hpp"
 #include "gdsr/sim/cloth_collision.hpp"
@@ -158,7 +159,7 @@ class ClothSolver {
   gdsr::Points3 x_, v_, xprev_;
   std::vector<double> mass_, winv_;
   std::vector<Edge> edges_;
-  std::vector<int> vertex_edge_start_, vertex_edges_;  // edges of vertex v: vertex_edges_[start[v] .. start[v + 1])
+  gdsr::Csr vertex_edges_;  // indices into edges_ of the edges at each vertex
   std::vector<double> edge_rest_placed_, edge_rest_pattern_;  // m, per edge
   std::vector<double> tether_rest_placed_, tether_rest_pattern_;  // m, per tether (placed: not below the pattern)
   std::vector<double> edge_scale_;  // per edge, this substep: compliance factor (1 stretched, 1/compression_ratio)
