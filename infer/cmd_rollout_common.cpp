@@ -16,6 +16,9 @@ namespace gdsr_cli {
 gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d) {
   gdsr::GDSR<float> model(gdsr::config_from_checkpoint(a.model));
   nn::load_checkpoint<float>(a.model, model, nullptr);
+  gdsr::GdsrAblation off;
+  for (const std::string& part : a.ablate) (part == "correction" ? off.correction : off.detail) = false;
+  model.set_ablation(off);
   gdsr::RolloutOptions opt = a.opt;
   opt.collisions = !a.no_collisions;
   gdsr::ProgressBar bar("roll-out");
@@ -85,6 +88,7 @@ gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r) {
   p.C_hat = std::move(r.C_hat);
   p.dataset = input_id(a);
   p.model = a.model;
+  for (const std::string& part : a.ablate) p.model += " (" + part + " off)";
   p.seconds_per_frame = r.seconds_per_frame;
   p.model_seconds_per_frame = r.model_seconds_per_frame;
   return p;
@@ -107,6 +111,10 @@ void add_rollout_options(CLI::App* c, RolloutArgs& a, bool data_required) {
           },
           "INT >= 1 or -1"));
   c->add_flag("--no-collisions", a.no_collisions, "skip the explicit collision handling");
+  c->add_option("--ablate", a.ablate,
+                "switch a part of the model off (repeatable): correction (C^ = C, no E) or detail (G = upsampled "
+                "C^, no A)")
+      ->check(CLI::IsMember({"correction", "detail"}));
 }
 
 void add_sequence_options(CLI::App* c, RolloutArgs& a) {

@@ -8,6 +8,7 @@
 #include "infer/rollout.hpp"
 
 #include <string>
+#include <vector>
 
 namespace CLI {
 class App;
@@ -19,6 +20,7 @@ struct RolloutArgs {
   std::string model, data, out = "runs/infer", pred;
   gdsr::RolloutOptions opt;
   bool no_collisions = false;
+  std::vector<std::string> ablate;  // parts of the model switched off: "correction", "detail"
   int obj_every = 0;
   int ssim_every = 1;
   gdsr::SequenceImportOptions seq;  // the user's own LR sequence (--lr-dir ...) instead of data
@@ -30,7 +32,7 @@ gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d);
 // The roll-out as a prediction (named after a.data and a.model).
 gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r);
 
-// --data (required unless data_required is false), --first, --frames, --no-collisions.
+// --data (required unless data_required is false), --first, --frames, --no-collisions, --ablate.
 void add_rollout_options(CLI::App* c, RolloutArgs& a, bool data_required = true);
 
 // --lr-dir, --lr-uv, --hr-uv, --subdivide, --body-dir, --scale, --fps: the user's own LR

@@ -34,11 +34,8 @@ RolloutResult rollout(const GDSR<float>& model, const Dataset& d, const RolloutO
   const auto start = std::chrono::steady_clock::now();
   for (int k = 0; k < count; ++k) {
     const int t = opt.first_frame + k;
-    // Before any prediction exists the history is the LR simulation itself (d = 0).
-    const Points3& h1 = k >= 1 ? r.C_hat[k - 1] : d.lr_frames[std::max(t - 1, 0)];
-    const Points3& h2 =
-        k >= 2 ? r.C_hat[k - 2] : (k == 1 ? d.lr_frames[std::max(t - 1, 0)] : d.lr_frames[std::max(t - 2, 0)]);
-    const FrameInput in = make_frame_input(d, t, h1, h2, body.get());
+    const FrameInput in = make_frame_input(d, t, rollout_history(d, r.C_hat, opt.first_frame, t, 1),
+                                           rollout_history(d, r.C_hat, opt.first_frame, t, 2), body.get());
     const auto m0 = std::chrono::steady_clock::now();
     const GdsrOutput<float> out = model.forward(graph, in, &all);
     model_secs += std::chrono::duration<double>(std::chrono::steady_clock::now() - m0).count();

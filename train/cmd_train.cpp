@@ -109,7 +109,7 @@ void run_train(TrainArgs& a, const gdsr::MpiRanks& mpi) {
     }
     if (L.validated) {
       std::fprintf(stderr, "\n");
-      std::printf("validation at step %lld: loss %.5g; vertex error %.2f mm (upsampled LR %.2f mm) on the patches\n",
+      std::printf("validation at step %lld: loss %.5g; roll-out vertex error %.2f mm (upsampled LR %.2f mm) on the patches\n",
                   static_cast<long long>(L.step), L.val_loss, L.val_vertex_mm, L.val_upsample_mm);
       std::fflush(stdout);
     }
@@ -141,6 +141,10 @@ void add_train_command(CLI::App& app) {
   c->add_option("--max-steps", a->opt.max_steps, "stop when the run reaches this many steps (resumes included)")
       ->each([a](const std::string&) { a->max_steps_given = true; });
   c->add_option("--frames-per-step", a->opt.frames_per_step, "frames whose gradients are averaged per step")
+      ->capture_default_str();
+  c->add_option("--rollout-history", a->opt.rollout_history,
+                 "push-forward: the history of a training frame is the model's own roll-out over the K frames "
+                 "before it (0: the downsampled HR truth, teacher forcing)")
       ->capture_default_str();
   c->add_option("--lr", a->opt.lr, "AdamW learning rate")->capture_default_str();
   c->add_option("--lr-halve-every", a->opt.lr_halve_every, "halve the lr every N steps")->capture_default_str();

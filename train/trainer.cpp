@@ -189,6 +189,7 @@ struct FrameLoss {
   ag::Tensorf total;
   double coarse = 0, fine = 0;          // weighted parts
   std::map<std::string, double> terms;  // unweighted
+  Points3 C_hat;                        // the corrected LR frame (the next frame's history in a roll-out)
   double vertex_m = 0, upsample_m = 0;  // validation only: mean |G - HR| and |upsampled LR - HR| on the patches
 };
 
@@ -203,10 +204,10 @@ double mean_distance_at(const Points3& predicted, const Points3& truth, const st
 
 // Forward and losses of frame t of a sequence (noise and rng: training draws; nullptr noise
 // for validation).
-FrameLoss frame_loss(TrainState& s, Sequence& seq, int t, const Lambdas& lambdas, std::mt19937_64& rng,
-                     nn::Rng* noise, const TrainOptions& opt) {
+FrameLoss frame_loss(TrainState& s, Sequence& seq, int t, const Points3& chat_tm1, const Points3& chat_tm2,
+                     const Lambdas& lambdas, std::mt19937_64& rng, nn::Rng* noise, const TrainOptions& opt) {
   const Dataset& d = *seq.d;
-  const FrameInput in = make_frame_input(d, t, seq.lr_truth[t - 1], seq.lr_truth[t - 2], seq.body.get());
+  const FrameInput in = make_frame_input(d, t, chat_tm1, chat_tm2, seq.body.get());
   PatchBatch batch;
   HrRequest request;
   if (opt.fine) {
@@ -221,6 +222,7 @@ FrameLoss frame_loss(TrainState& s, Sequence& seq, int t, const Lambdas& lambdas
   f.total = total_loss(lambdas, coarse.total, fine.total);
   f.coarse = lambdas.coarse * coarse.total.item();
   f.fine = fine.total.defined() ? lambdas.fine * fine.total.item() : 0.0;
+  f.C_hat = gdsr::to_points(out.C_hat);
   f.terms = coarse.log();                   // keys c_position, c_normal, ...
   if (opt.fine) f.terms.merge(fine.log());  // f_position, f_vgg, ...
   if (opt.fine && !noise) {
@@ -346,7 +348,16 @@ TrainLog train_step(TrainState& s, const TrainOptions& opt) {
     std::mt19937_64 patch_rng(s.rng());
     nn::Rng noise(s.noise.next());
     if (k % opt.ranks != opt.rank) continue;
-    FrameLoss f = frame_loss(s, s.seqs[static_cast<size_t>(si)], t, lambdas, patch_rng, &noise, opt);
+    Sequence& seq = s.seqs[static_cast<size_t>(si)];
+    FrameLoss f;
+    if (opt.rollout_history > 0) {  // push-forward: the history is the model's own, from a roll-out
+      const int first = std::max(t - opt.rollout_history, 0);
+      const std::vector<Points3> pred = corrected_rollout(*s.model, seq.graph, *seq.d, seq.body.get(), first, t - first);
+      f = frame_loss(s, seq, t, rollout_history(*seq.d, pred, first, t, 1), rollout_history(*seq.d, pred, first, t, 2),
+                     lambdas, patch_rng, &noise, opt);
+    } else {  // teacher forcing
+      f = frame_loss(s, seq, t, seq.lr_truth[t - 1], seq.lr_truth[t - 2], lambdas, patch_rng, &noise, opt);
+    }
     check_finite_loss(s, f, si, t);
     L.loss += inv * f.total.item();
     L.coarse += inv * f.coarse;
@@ -387,8 +398,9 @@ void record_step(TrainState& s, const TrainLog& L) {
   ++s.p.interval_count;
 }
 
-// Mean losses over every validation frame: no gradient, no noise, patches from a fixed seed
-// (the same patches at every validation).
+// Mean losses over every frame of a roll-out of each validation clip from its frame 0 (the
+// history is the model's own, as in `gdsr infer`): no gradient, no noise, patches from a
+// fixed seed (the same patches at every validation).
 void validate(TrainState& s, TrainLog& L, const TrainOptions& opt) {
   if (s.val.empty()) return;
   ag::NoGradGuard no_grad;
@@ -396,15 +408,19 @@ void validate(TrainState& s, TrainLog& L, const TrainOptions& opt) {
   const Lambdas lambdas = opt.loss.schedule ? lambda_schedule(opt.loss, L.epoch) : Lambdas{1, 1};
   double total = 0, coarse = 0, fine = 0, vertex = 0, upsampled = 0;
   int n = 0;
-  for (Sequence& seq : s.val)
-    for (int t = 2; t < static_cast<int>(seq.d->lr_frames.size()); ++t, ++n) {
-      const FrameLoss f = frame_loss(s, seq, t, lambdas, rng, nullptr, opt);
+  for (Sequence& seq : s.val) {
+    std::vector<Points3> pred;  // a roll-out from frame 0, as `gdsr infer` runs
+    for (int t = 0; t < static_cast<int>(seq.d->lr_frames.size()); ++t, ++n) {
+      FrameLoss f = frame_loss(s, seq, t, rollout_history(*seq.d, pred, 0, t, 1), rollout_history(*seq.d, pred, 0, t, 2),
+                               lambdas, rng, nullptr, opt);
+      pred.push_back(std::move(f.C_hat));
       total += f.total.item();
       coarse += f.coarse;
       fine += f.fine;
       vertex += f.vertex_m;
       upsampled += f.upsample_m;
     }
+  }
   L.validated = true;
   L.val_loss = total / n;
   L.val_coarse = coarse / n;
@@ -475,6 +491,9 @@ void validate_train_options(const TrainOptions& opt) {
   if (opt.ranks > 1 && !opt.allreduce_sum) gdsr::fail("train", "several ranks need an all-reduce");
   if (opt.frames_per_step <= 0)
     gdsr::fail("train", "--frames-per-step must be positive, got " + std::to_string(opt.frames_per_step));
+  if (opt.rollout_history < 0 || opt.rollout_history > 64)
+    gdsr::fail("train", "--rollout-history must be 0 (teacher forcing) to 64 frames, got " +
+                            std::to_string(opt.rollout_history));
   if (!std::isfinite(opt.lr) || opt.lr <= 0) gdsr::fail("train", "--lr must be finite and > 0, got " + std::to_string(opt.lr));
   if (!std::isfinite(opt.lr_floor) || opt.lr_floor < 0) gdsr::fail("train", "the lr floor must be finite and >= 0");
   if (opt.lr_halve_every <= 0)

@@ -1,5 +1,6 @@
 // Training GDSR on one or more datasets (paper 4.5): one frame per step, teacher forcing
-// (the history C^_{t-1}, C^_{t-2} is the downsampled HR ground truth), coarse loss on the
+// (the history C^_{t-1}, C^_{t-2} is the downsampled HR ground truth) or push-forward
+// (rollout_history: the model's own roll-out over the frames before), coarse loss on the
 // corrected LR garment and the patch-based fine loss on the HR vertices under a batch of UV
 // patches (A is evaluated only on the LR triangles those patches need). AdamW with the
 // reference settings, lr step decay, the lambda schedule, periodic atomic checkpoints.
@@ -32,6 +33,11 @@ struct TrainOptions {
   int64_t max_steps = -1;  // stop when the run (counted from its start, resumes included)
                            // reaches this many steps; -1: no limit, otherwise > 0
   int frames_per_step = 1; // K frames' gradients averaged per optimizer step, > 0
+  // Push-forward (0: teacher forcing, the reference): the history C^_{t-1}, C^_{t-2} of a
+  // training frame t is the model's own, rolled out (E only, no gradient) over the K frames
+  // before t from the LR simulation as `gdsr infer` starts, so training sees the inputs a
+  // roll-out feeds the model rather than the downsampled HR truth.
+  int rollout_history = 0;
   double lr = 1e-4;        // AdamW, reference settings
   double weight_decay = 0.01;
   bool amsgrad = true;
@@ -73,7 +79,7 @@ struct TrainLog {
   bool checkpointed = false;            // a checkpoint was written after this step
   bool validated = false;               // val_* hold the validation figures of this step
   double val_loss = 0, val_coarse = 0, val_fine = 0;  // means over the validation frames
-  // mm, mean over the validation frames' patch vertices of |G - HR| (one-step prediction) and, as the
+  // mm, mean over the validation frames' patch vertices of |G - HR| (in a roll-out) and, as the
   // yardstick, of |upsampled LR input - HR| at the same vertices; NaN without patches (--no-fine)
   double val_vertex_mm = 0, val_upsample_mm = 0;
 };

@@ -11,4 +11,5 @@ void add_train_command(CLI::App& app);  // train/cmd_train.cpp: gdsr train
 void add_infer_command(CLI::App& app);  // infer/cmd_infer.cpp: gdsr infer
 void add_eval_command(CLI::App& app);   // infer/cmd_eval.cpp: gdsr eval
 void add_export_command(CLI::App& app); // infer/cmd_export.cpp: gdsr export
+void add_weights_command(CLI::App& app); // train/cmd_weights.cpp: gdsr weights
 void add_demo_command(CLI::App& app);   // train/cmd_demo.cpp: gdsr demo (the README's main job)

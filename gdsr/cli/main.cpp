@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   add_demo_command(app);
   add_data_command(app);
   add_train_command(app);
+  add_weights_command(app);
   add_infer_command(app);
   add_eval_command(app);
   add_export_command(app);

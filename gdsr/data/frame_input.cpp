@@ -2,6 +2,9 @@
 
 #include "gdsr/error.hpp"
 
+#include "autograd/tensor.hpp"
+#include "gdsr/model/frames.hpp"
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -28,6 +31,29 @@ FrameInput make_frame_input(const Dataset& d, int t, const Points3& chat_tm1, co
     in.contact_tm1 = {before.point, before.normal};
   }
   return in;
+}
+
+const Points3& rollout_history(const Dataset& d, const std::vector<Points3>& pred, int first, int t, int back) {
+  const int k = t - back - first;  // index of frame t - back among the predictions
+  if (k >= 0) {
+    if (k >= static_cast<int>(pred.size()))
+      gdsr::fail("rollout_history", "frame " + std::to_string(t - back) + " has not been predicted yet");
+    return pred[static_cast<size_t>(k)];
+  }
+  return d.lr_frames[static_cast<size_t>(std::max(t - back, 0))];
+}
+
+std::vector<Points3> corrected_rollout(const GDSR<float>& model, const GarmentGraph& graph, const Dataset& d,
+                                       BodyQuery* body, int first, int count) {
+  ag::NoGradGuard no_grad;
+  std::vector<Points3> pred;
+  pred.reserve(static_cast<size_t>(std::max(count, 0)));
+  for (int t = first; t < first + count; ++t) {
+    const FrameInput in =
+        make_frame_input(d, t, rollout_history(d, pred, first, t, 1), rollout_history(d, pred, first, t, 2), body);
+    pred.push_back(to_points(model.forward(graph, in, nullptr).C_hat));
+  }
+  return pred;
 }
 
 std::unique_ptr<BodyQuery> make_body_query(const Dataset& d) {

@@ -6,12 +6,26 @@
 #include "gdsr/body/body_query.hpp"
 #include "gdsr/data/dataset.hpp"
 #include "gdsr/model/features.hpp"
+#include "gdsr/model/gdsr_model.hpp"
+
+#include <vector>
 
 namespace gdsr {
 
 // body: a query on the dataset's body (any frame; it is moved to frame t here), or null when
 // the dataset has no body (then has_body = false and no query runs).
 FrameInput make_frame_input(const Dataset& d, int t, const Points3& chat_tm1, const Points3& chat_tm2, BodyQuery* body);
+
+// The history C^_{t-back} (back = 1 or 2) of frame t in a roll-out that started at frame
+// `first`, where pred[i] is the corrected LR frame first + i. Before any prediction exists the
+// history is the LR simulation itself (d = 0), as at the start of `gdsr infer`.
+const Points3& rollout_history(const Dataset& d, const std::vector<Points3>& pred, int first, int t, int back);
+
+// The corrected LR frames C^ of frames first .. first + count - 1 rolled out by the model's
+// E alone (no HR request, no noise, no gradient): the push-forward history of training.
+// body: as for make_frame_input.
+std::vector<Points3> corrected_rollout(const GDSR<float>& model, const GarmentGraph& graph, const Dataset& d,
+                                       BodyQuery* body, int first, int count);
 
 // A BodyQuery on frame 0 of the dataset's body, or null without a body.
 std::unique_ptr<BodyQuery> make_body_query(const Dataset& d);

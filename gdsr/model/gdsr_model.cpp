@@ -76,8 +76,13 @@ template <class T> GdsrOutput<T> GDSR<T>::decode(const GarmentGraph& g, const ag
   out.C = C_t;
   out.z = z;
   auto t0 = Clock::now();
-  out.D = e_->forward(g, ag::slice_cols(z, zd, z.cols()), C_t);
-  out.C_hat = ag::add(C_t, out.D);
+  if (ablation_.correction) {
+    out.D = e_->forward(g, ag::slice_cols(z, zd, z.cols()), C_t);
+    out.C_hat = ag::add(C_t, out.D);
+  } else {
+    out.D = ag::Tensor<T>::zeros({V, 3});
+    out.C_hat = C_t;
+  }
   if (timings) timings->e += since(t0);
   if (!hr || hr->size() == 0) return out;
 
@@ -116,12 +121,17 @@ template <class T> GdsrOutput<T> GDSR<T>::decode(const GarmentGraph& g, const ag
   auto restore = [&](const ag::Tensor<T>& x) { return sorted ? x : ag::index_select_rows(x, back); };
 
   t0 = Clock::now();
-  out.field = a_->parameters_for(g.F, out.faces, ag::slice_cols(z, 0, zd));
+  if (ablation_.detail) out.field = a_->parameters_for(g.F, out.faces, ag::slice_cols(z, 0, zd));
   if (timings) timings->a += since(t0);
   t0 = Clock::now();
-  const ag::Tensor<T> r_local = a_->eval_field(out.field, bary, group);
-  const ag::Tensor<T> frames = triangle_frames_ad(out.C_hat, g.F, out.faces, T(cfg_.frame_eps));
-  const ag::Tensor<T> r_world = local_to_world(r_local, ag::index_select_rows(frames, group));
+  ag::Tensor<T> r_local, r_world;
+  if (ablation_.detail) {
+    r_local = a_->eval_field(out.field, bary, group);
+    const ag::Tensor<T> frames = triangle_frames_ad(out.C_hat, g.F, out.faces, T(cfg_.frame_eps));
+    r_world = local_to_world(r_local, ag::index_select_rows(frames, group));
+  } else {
+    r_local = r_world = ag::Tensor<T>::zeros({N, 3});
+  }
   const ag::Tensor<T> up = ag::interpolate_rows(out.C_hat, corners, bary);
   const ag::Tensor<T> G = ag::add(up, r_world);
   out.residual_local = restore(r_local);

@@ -44,6 +44,14 @@ struct GdsrTimings {
   double features = 0, h = 0, e = 0, a = 0, field = 0;
 };
 
+// Parts of a trained model switched off at inference (the ablations of issue #12, without
+// retraining): correction off gives C_hat = C (D = 0), detail off gives G = the barycentric
+// upsample of C_hat (A is not run, residual 0).
+struct GdsrAblation {
+  bool correction = true;
+  bool detail = true;
+};
+
 template <class T> struct GdsrOutput {
   GraphFeatures<T> features;
   ag::Tensor<T> C;       // V x 3, the LR input positions used at t
@@ -76,6 +84,8 @@ template <class T> class GDSR : public nn::Module<T> {
   GdsrOutput<T> decode(const GarmentGraph& g, const ag::Tensor<T>& C_t, const ag::Tensor<T>& z, const HrRequest* hr,
                        GdsrTimings* timings = nullptr) const;
 
+  void set_ablation(const GdsrAblation& a) { ablation_ = a; }
+  const GdsrAblation& ablation() const { return ablation_; }
   const ModelConfig& config() const { return cfg_; }
   MeshGraphNet<T>& h() const { return *h_; }
   CorrectionDecoder<T>& e() const { return *e_; }
@@ -83,6 +93,7 @@ template <class T> class GDSR : public nn::Module<T> {
 
  private:
   ModelConfig cfg_;
+  GdsrAblation ablation_;
   std::shared_ptr<MeshGraphNet<T>> h_;
   std::shared_ptr<CorrectionDecoder<T>> e_;
   std::shared_ptr<HyperNet<T>> a_;

@@ -291,6 +291,8 @@ std::vector<Case> corpus() {
       {kInferBad, "bad.ckpt", bad_ckpt([](S k) { flip(k, -1); })},
       {kInferBad, "bad.ckpt", bad_ckpt([](S k) { put(k, "GDSRCKPT this is text\n"); })},
       {"infer --data {d}/ds --out {d}/pred --model {d}/none.ckpt", "none.ckpt"},
+      {"weights --out {d}/w.ckpt --model {d}/none.ckpt", "none.ckpt"},
+      {"weights --out {d}/w.ckpt --model {d}/bad.ckpt", "bad.ckpt", bad_ckpt([](S k) { flip(k, 100); })},
       {"infer --data {d}/ds --out {d}/pred --model {d}/ds", "ds"},
       // ---- infer: flags
       {kInfer + "{d}/ds --frames 0", "--frames"},
@@ -299,6 +301,7 @@ std::vector<Case> corpus() {
       {kInfer + "{d}/ds --first 99", "--first"},
       {kInfer + "{d}/ds --first 2 --frames 9", "--frames"},
       {kInfer + "{d}/ds --obj-every -1", "--obj-every"},
+      {kInfer + "{d}/ds --ablate everything", "--ablate"},
       {kInfer + "{d}/missing", "missing"},
       {kInfer + "{d}/ds --lr-dir {d}/exp_md/lr", "--lr-dir"},
       {"infer --model {d}/run/model.ckpt --out {d}/pred", "--data"},

@@ -138,12 +138,13 @@ TEST_CASE("cli train: the run folder holds the CSV log and loss curves and confi
     CHECK(header.find(c) != std::string::npos);
   CHECK(!column(rows[2], 20).empty());  // step 3: a checkpoint, validated
   CHECK(column(rows[3], 20).empty());
-  // vertex error of the one-step prediction and of the upsampled LR input, mm, on the patches
+  // vertex error of the roll-out and of the upsampled LR input, mm, on the patches
   CHECK(header.find("val_vertex_mm,val_upsample_mm") != std::string::npos);
   CHECK(std::stod(column(rows[2], 23)) > 0);
   CHECK(std::stod(column(rows[2], 24)) > 0);
   CHECK(column(rows[3], 23).empty());
   CHECK(r.out.find("validation at step 3: loss") != std::string::npos);
+  CHECK(r.out.find("roll-out vertex error") != std::string::npos);
   CHECK(std::stod(column(rows[0], 18)) > 0);  // gradient norm
   CHECK(fs::file_size(out + "/loss_curves.png") > 5000);
   CHECK(fs::exists(out + "/model.best.ckpt"));
@@ -210,4 +211,37 @@ TEST_CASE("cli train: bad flags and files give a one-line error and write nothin
     if (e.path().filename().string().find("hr_frames") != std::string::npos) fs::remove(e.path());
   check_one_line_error(gdsr_run(dir, base + " --max-steps 4"), "hr_frames");
   CHECK(nn::read_checkpoint(out + "/model.ckpt").step == 2);
+}
+
+TEST_CASE("cli weights: a run's weights alone load in infer with the same prediction and cannot be resumed") {
+  TempDir dir("cli_weights");
+  const std::string data = dir / "wave";
+  gdsr::write_dataset(data, gdsr_test::wave_dataset());
+  const std::string run = dir / "run";
+  REQUIRE(gdsr_run(dir, "train --data '" + data + "' --config '" + GDSR_SOURCE_DIR +
+                            "/configs/tiny.json' --no-vgg --patches 2 --patch-size 32 --max-steps 3 --rollout-history 2 " +
+                            "--out '" + run + "'")
+              .status == 0);
+  const std::string weights = dir / "w.ckpt";
+  const Run w = gdsr_run(dir, "weights --model '" + run + "/model.ckpt' --out '" + weights + "'");
+  REQUIRE(w.status == 0);
+  CHECK(w.out.find("at step 3") != std::string::npos);
+  const nn::Checkpoint ck = nn::read_checkpoint(weights);
+  CHECK(ck.step == 3);
+  int params = 0;
+  for (const auto& e : ck.entries) {
+    CHECK(e.name.rfind("param/", 0) == 0);  // no optimizer state
+    CHECK(e.dtype == nn::DType::F32);
+    ++params;
+  }
+  CHECK(params > 0);
+  CHECK(fs::file_size(weights) < fs::file_size(run + "/model.ckpt") / 2);
+  for (const auto& [model, out] : {std::pair{run + "/model.ckpt", dir / "pa"}, std::pair{weights, dir / "pb"}})
+    REQUIRE(gdsr_run(dir, "infer --model '" + model + "' --data '" + data + "' --out '" + out + "'").status == 0);
+  CHECK(slurp(dir / "pa/pred_hr.bin") == slurp(dir / "pb/pred_hr.bin"));
+  const Run resumed = gdsr_run(dir, "train --data '" + data + "' --config '" + GDSR_SOURCE_DIR +
+                                        "/configs/tiny.json' --no-vgg --max-steps 4 --resume '" + weights +
+                                        "' --out '" + run + "'");
+  CHECK(resumed.status != 0);
+  check_one_line_error(resumed, "w.ckpt");
 }

@@ -2,6 +2,7 @@
 // frame and every HR vertex is predicted, finite, and no body query is made without a body.
 #include <doctest/doctest.h>
 
+#include "gdsr/data/frame_input.hpp"
 #include "gdsr/model/model_config.hpp"
 #include "infer/rollout.hpp"
 #include "tests/support/data_fixtures.hpp"
@@ -23,4 +24,55 @@ TEST_CASE("rollout: all frames and HR vertices of an untrained tiny model, finit
   const gdsr::RolloutResult ro2 = gdsr::rollout(model, d, part);
   CHECK(ro2.first_frame == 2);
   CHECK(ro2.G.size() == 3);
+}
+
+TEST_CASE("rollout: a roll-out from a later frame starts from the LR simulation; E alone gives the same C^") {
+  const gdsr::Dataset d = gdsr_test::wave_dataset(7);
+  const gdsr::GDSR<float> model(gdsr::load_model_config(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json"));
+  gdsr::RolloutOptions part;
+  part.first_frame = 3;
+  part.frames = 4;
+  part.collisions = false;
+  const gdsr::RolloutResult ro = gdsr::rollout(model, d, part);
+  // The training's push-forward history: the same frames without the HR request.
+  const std::vector<gdsr::Points3> pred = gdsr::corrected_rollout(model, gdsr::build_graph(d.lr), d, nullptr, 3, 4);
+  REQUIRE(pred.size() == ro.C_hat.size());
+  for (size_t k = 0; k < pred.size(); ++k) {
+    CHECK((pred[k] - ro.C_hat[k]).cwiseAbs().maxCoeff() == 0.0);  // E does not depend on A
+    CHECK((pred[k] - d.lr_frames[3 + k]).norm() > 0);                 // and it did correct the frame
+  }
+  // History before the first prediction is the LR simulation at t-1 and t-2 (d = 0) ...
+  CHECK(&gdsr::rollout_history(d, pred, 3, 3, 1) == &d.lr_frames[2]);
+  CHECK(&gdsr::rollout_history(d, pred, 3, 3, 2) == &d.lr_frames[1]);
+  CHECK(&gdsr::rollout_history(d, pred, 3, 4, 2) == &d.lr_frames[2]);  // not frame 3: that is t-1
+  // ... then the predictions; a frame not predicted yet is an error, not a silent stand-in.
+  CHECK(&gdsr::rollout_history(d, pred, 3, 4, 1) == &pred[0]);
+  CHECK(&gdsr::rollout_history(d, pred, 3, 6, 2) == &pred[1]);
+  CHECK(&gdsr::rollout_history(d, pred, 0, 0, 2) == &d.lr_frames[0]);  // clamped at the start
+  CHECK_THROWS_WITH_AS(gdsr::rollout_history(d, pred, 3, 9, 1), doctest::Contains("has not been predicted"),
+                       std::runtime_error);
+}
+
+TEST_CASE("rollout: ablations switch E (C^ = C) or A (G = upsampled C^) off, and nothing else") {
+  const gdsr::Dataset d = gdsr_test::wave_dataset(5);
+  gdsr::GDSR<float> model(gdsr::load_model_config(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json"));
+  gdsr::RolloutOptions o;
+  o.collisions = false;
+  const gdsr::RolloutResult full = gdsr::rollout(model, d, o);
+  model.set_ablation({false, true});
+  const gdsr::RolloutResult no_e = gdsr::rollout(model, d, o);
+  model.set_ablation({true, false});
+  const gdsr::RolloutResult no_a = gdsr::rollout(model, d, o);
+  model.set_ablation({});
+  const gdsr::RolloutResult again = gdsr::rollout(model, d, o);
+  for (size_t k = 0; k < d.lr_frames.size(); ++k) {
+    // No correction: C^ is the LR frame (to float rounding; the model runs in float).
+    CHECK((no_e.C_hat[k] - d.lr_frames[k]).cwiseAbs().maxCoeff() < 1e-7);
+    CHECK((full.C_hat[k] - d.lr_frames[k]).cwiseAbs().maxCoeff() > 1e-5);
+    // No detail: the HR frame is the upsampled corrected frame (float upsample against double).
+    CHECK((no_a.G[k] - gdsr::upsample(d.corr, no_a.C_hat[k])).cwiseAbs().maxCoeff() < 1e-6);
+    CHECK((full.G[k] - gdsr::upsample(d.corr, full.C_hat[k])).cwiseAbs().maxCoeff() > 1e-6);
+    CHECK((no_a.C_hat[k] - full.C_hat[k]).cwiseAbs().maxCoeff() == 0.0);  // E untouched by switching A off
+    CHECK((again.G[k] - full.G[k]).cwiseAbs().maxCoeff() == 0.0);         // switched back on: as before
+  }
 }

@@ -92,6 +92,12 @@ TEST_CASE("trainer: resume with two frames per step is bit-identical to one run"
   check_exact_resume(o, 10, 5);  // step 5 ends at frame 10, inside epoch 1
 }
 
+TEST_CASE("trainer: resume with the push-forward history is bit-identical to one run") {
+  gdsr::TrainOptions o = resume_options();
+  o.rollout_history = 3;  // the unroll draws no random numbers and depends on the parameters only
+  check_exact_resume(o, 8, 4);
+}
+
 TEST_CASE("trainer: resume with the small preset is bit-identical to one run") {
   // A model with wide layers: Eigen's vectorised reductions on its tensors rounded by heap
   // alignment, which differs between the first and the resumed trainer (autograd/aligned_new.cpp).
@@ -159,6 +165,8 @@ TEST_CASE("trainer: bad options are refused before anything is written") {
       {"--max-steps must be positive, got 0", [](auto& o) { o.max_steps = 0; }},
       {"--max-steps must be positive, got -3", [](auto& o) { o.max_steps = -3; }},
       {"--frames-per-step must be positive", [](auto& o) { o.frames_per_step = 0; }},
+      {"--rollout-history must be 0 (teacher forcing) to 64 frames, got -1", [](auto& o) { o.rollout_history = -1; }},
+      {"--rollout-history must be 0 (teacher forcing) to 64 frames, got 65", [](auto& o) { o.rollout_history = 65; }},
       {"--lr must be finite and > 0, got nan", [nan](auto& o) { o.lr = nan; }},
       {"--lr must be finite and > 0, got -1", [](auto& o) { o.lr = -1; }},
       {"--lr must be finite and > 0, got inf", [](auto& o) { o.lr = std::numeric_limits<double>::infinity(); }},
