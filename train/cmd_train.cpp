@@ -146,6 +146,8 @@ void add_train_command(CLI::App& app) {
                  "push-forward: the history of a training frame is the model's own roll-out over the K frames "
                  "before it (0: the downsampled HR truth, teacher forcing)")
       ->capture_default_str();
+  c->add_flag("--detail-target", a->opt.detail_target,
+              "fine loss against the HR frame's own detail on the model's coarse shape (default: the HR frame)");
   c->add_option("--lr", a->opt.lr, "AdamW learning rate")->capture_default_str();
   c->add_option("--lr-halve-every", a->opt.lr_halve_every, "halve the lr every N steps")->capture_default_str();
   c->add_option("--seed", a->opt.seed, "frame order, patches, noise")->capture_default_str();

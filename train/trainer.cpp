@@ -11,6 +11,7 @@
 #include "nn/feature_loss.hpp"
 #include "nn/lr_schedule.hpp"
 #include "nn/vgg.hpp"
+#include "train/detail_target.hpp"
 #include "train/train_state.hpp"
 
 #include <nlohmann/json.hpp>
@@ -217,7 +218,13 @@ FrameLoss frame_loss(TrainState& s, Sequence& seq, int t, const Points3& chat_tm
   const GdsrOutput<float> out = s.model->forward(seq.graph, in, opt.fine ? &request : nullptr, noise);
   const CoarseLoss<float> coarse = coarse_loss(opt.loss, seq.lr_topo, out.C_hat, seq.lr_truth[t]);
   FineLoss<float> fine;
-  if (opt.fine) fine = fine_loss(opt.loss, batch, out.G, d.hr_frames[t], s.image_loss);
+  if (opt.fine && opt.detail_target)
+    fine = fine_loss(opt.loss, batch, out.G,
+                     detail_target(d.corr, d.hr_frames[t], seq.lr_truth[t], gdsr::to_points(out.C_hat), batch.vertices,
+                                   opt.model.frame_eps),
+                     s.image_loss);
+  else if (opt.fine)
+    fine = fine_loss(opt.loss, batch, out.G, d.hr_frames[t], s.image_loss);
   FrameLoss f;
   f.total = total_loss(lambdas, coarse.total, fine.total);
   f.coarse = lambdas.coarse * coarse.total.item();

@@ -38,6 +38,10 @@ struct TrainOptions {
   // before t from the LR simulation as `gdsr infer` starts, so training sees the inputs a
   // roll-out feeds the model rather than the downsampled HR truth.
   int rollout_history = 0;
+  // Fine-loss target (false: the HR frame, the reference): the HR frame's own detail carried
+  // onto the model's coarse shape (train/detail_target.hpp), so that A is not asked to learn
+  // the LR-HR drape difference. Validation's vertex error is always against the HR frame.
+  bool detail_target = false;
   double lr = 1e-4;        // AdamW, reference settings
   double weight_decay = 0.01;
   bool amsgrad = true;

@@ -101,3 +101,19 @@ TEST_CASE("trainer: push-forward feeds the model its own history; validation sco
   CHECK(pushed[2].val_upsample_mm == teacher[2].val_upsample_mm);
   CHECK(pushed[2].val_upsample_mm > 0);
 }
+
+TEST_CASE("trainer: --detail-target changes only the fine terms of a step, not the coarse ones") {
+  const gdsr::Dataset d = gdsr_test::wave_dataset();
+  gdsr::TrainOptions o = tiny_train_options();
+  o.max_steps = 1;
+  auto step = [&](bool detail) {
+    o.detail_target = detail;
+    gdsr::TrainLog out;
+    gdsr::train_gdsr({&d}, o, [&](const gdsr::TrainLog& L) { out = L; });
+    return out;
+  };
+  const gdsr::TrainLog hr = step(false), detail = step(true);
+  CHECK(detail.terms.at("c_position") == hr.terms.at("c_position"));  // same frame, same model
+  CHECK(std::isfinite(detail.terms.at("f_position")));
+  CHECK(detail.terms.at("f_position") != hr.terms.at("f_position"));
+}
