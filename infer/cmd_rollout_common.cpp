@@ -21,6 +21,7 @@ gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d) {
   model.set_ablation(off);
   gdsr::RolloutOptions opt = a.opt;
   opt.collisions = !a.no_collisions;
+  opt.collision.sigma_b = gdsr::body_offset_for(d.manifest.sim_params, a.body_offset);
   gdsr::ProgressBar bar("roll-out");
   gdsr::RolloutResult r = gdsr::rollout(model, d, opt, bar.callback());
   bar.finish();
@@ -28,9 +29,9 @@ gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d) {
   for (const auto& c : r.collisions) pushed += c.hr_body + c.hr_layer;
   std::printf(
       "rolled out %zu frames: %.3f s/frame (model %.3f s), LR %lld -> HR %lld vertices, %d HR vertices "
-      "moved by collision handling\n",
+      "moved by collision handling (body offset %.1f mm)\n",
       r.G.size(), r.seconds_per_frame, r.model_seconds_per_frame, static_cast<long long>(d.lr.V.rows()),
-      static_cast<long long>(d.hr.V.rows()), pushed);
+      static_cast<long long>(d.hr.V.rows()), pushed, 1000 * opt.collision.sigma_b);
   return r;
 }
 
@@ -111,6 +112,10 @@ void add_rollout_options(CLI::App* c, RolloutArgs& a, bool data_required) {
           },
           "INT >= 1 or -1"));
   c->add_flag("--no-collisions", a.no_collisions, "skip the explicit collision handling");
+  c->add_option("--body-offset", a.body_offset,
+                "metres the collision handling keeps the HR garment off the body (default: the dataset's simulation "
+                "thickness, else the paper's 0.015)")
+      ->check(CLI::Range(0.0, 0.1));
   c->add_option("--ablate", a.ablate,
                 "switch a part of the model off (repeatable): correction (C^ = C, no E) or detail (G = upsampled "
                 "C^, no A)")

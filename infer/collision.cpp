@@ -59,6 +59,14 @@ int push_group(const Groups& g, int i, const Vec3& p, const Vec3& n, double sigm
 
 }  // namespace
 
+double body_offset_for(const nlohmann::json& sim_params, double given) {
+  if (given >= 0) return given;
+  const auto it = sim_params.find("thickness_m");
+  if (it != sim_params.end() && it->is_number() && it->get<double>() > 0 && it->get<double>() < 0.1)
+    return it->get<double>();
+  return CollisionConfig{}.sigma_b;
+}
+
 BodyQueryFn body_query_fn(const BodyQuery& body) {
   return [&body](const Points3& q, Points3& closest, Points3& normal) {
     ClosestPoints c = body.closest(q, true);

@@ -6,6 +6,7 @@
 # Example (the recipe's held-out clips):
 #   scripts/eval_heldout.sh build models/gdsr_small_skirt.ckpt runs/eval \
 #     runs/recipe/skirt_short_01_03_1s runs/recipe/skirt_short_60_03_2s
+# GDSR_INFER_ARGS adds flags to gdsr infer, e.g. GDSR_INFER_ARGS="--ablate detail".
 set -e
 usage="usage: $0 BUILD_DIR MODEL OUT_DIR DATASET..."
 build=$(cd "${1:?$usage}" && pwd)
@@ -18,7 +19,9 @@ reports=""
 for data in "$@"; do
   name=$(basename "$data")
   echo "evaluating $model on $name" >&2
-  "$build/gdsr" infer --model "$model" --data "$data" --out "$out/$name" > "$out/$name.infer.log" 2>&1 ||
+  # shellcheck disable=SC2086
+  "$build/gdsr" infer --model "$model" --data "$data" --out "$out/$name" ${GDSR_INFER_ARGS:-} \
+    > "$out/$name.infer.log" 2>&1 ||
     { echo "gdsr infer failed on $data, see $out/$name.infer.log" >&2; exit 1; }
   "$build/gdsr" eval --pred "$out/$name" --data "$data" --report "$out/$name.report" --no-video --no-export \
     > "$out/$name.eval.log" 2>&1 || { echo "gdsr eval failed on $data, see $out/$name.eval.log" >&2; exit 1; }

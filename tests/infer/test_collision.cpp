@@ -178,3 +178,13 @@ TEST_CASE("collision: the Embree body adapter pushes out of a real body mesh") {
   CHECK((g - g0).cross(n).norm() < 1e-12);
   CHECK(n.y() > 0.5);
 }
+
+TEST_CASE("collision: the body offset is the flag, else the dataset's simulation thickness, else the paper's") {
+  nlohmann::json sim = {{"thickness_m", 0.004}};
+  CHECK(gdsr::body_offset_for(sim, -1) == 0.004);
+  CHECK(gdsr::body_offset_for(sim, 0.01) == 0.01);
+  CHECK(gdsr::body_offset_for(sim, 0) == 0.0);  // 0 given: no offset, the plain surface
+  CHECK(gdsr::body_offset_for(nlohmann::json::object(), -1) == 0.015);  // imported data: the paper's
+  CHECK(gdsr::body_offset_for({{"thickness_m", "4 mm"}}, -1) == 0.015);  // not a number: ignored
+  CHECK(gdsr::body_offset_for({{"thickness_m", 2.0}}, -1) == 0.015);     // 2 m is not a thickness
+}
