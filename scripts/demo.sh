@@ -6,7 +6,9 @@
 #   4.   `gdsr train`: a small GDSR model on the training sequence;
 #   5.   `gdsr infer` + `gdsr eval`: roll-out on the unseen motion, compared with the HR
 #        simulation (vertex error, normal-map SSIM, stretch energies) and a preview PNG;
-#        the report folder runs/demo/report (tables, plots, images, video, glTF / PC2 exports).
+#        the report folder runs/demo/report (tables, plots, images, video, glTF / PC2 exports);
+#   6.   the same with the trained model shipped in models/ (models/README.md: its data,
+#        training and held-out figures, which this step reproduces), report runs/demo/report_shipped.
 # Outputs go to runs/demo (override with GDSR_DEMO_OUT). Datasets already made from the same clip by
 # the same solver revision are reused (data make --skip-built); others are rebuilt.
 set -euo pipefail
@@ -33,5 +35,9 @@ echo "== 4. Train GDSR (configs/small.json) =="
 echo "== 5. Roll-out on the unseen motion 01_03, evaluation =="
 "$gdsr" infer --model "$out/model/model.ckpt" --data "$out/test_skirt_01_03" --out "$out/infer"
 "$gdsr" eval --pred "$out/infer" --data "$out/test_skirt_01_03" --report "$out/report"
-echo "previews: $out/data_preview.png $out/infer/preview.png"
+echo "== 6. The shipped model (models/gdsr_small_skirt.ckpt, trained on three motions) on the same unseen motion =="
+"$gdsr" infer --model models/gdsr_small_skirt.ckpt --data "$out/test_skirt_01_03" --out "$out/infer_shipped"
+"$gdsr" eval --pred "$out/infer_shipped" --data "$out/test_skirt_01_03" --report "$out/report_shipped" \
+  --no-video --no-export
+echo "previews: $out/data_preview.png $out/infer/preview.png $out/infer_shipped/preview.png"
 echo "report: $out/report/report.md (plots, LR | GDSR | HR images, rollout.avi, glTF / PC2 exports in export/)"
