@@ -26,7 +26,7 @@ TEST_CASE("rollout: all frames and HR vertices of an untrained tiny model, finit
   CHECK(ro2.G.size() == 3);
 }
 
-TEST_CASE("rollout: a roll-out from a later frame starts from the LR simulation; E alone gives the same C^") {
+TEST_CASE("rollout: a roll-out from a later frame starts from the LR simulation, and E alone gives the same C^") {
   const gdsr::Dataset d = gdsr_test::wave_dataset(7);
   const gdsr::GDSR<float> model(gdsr::load_model_config(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json"));
   gdsr::RolloutOptions part;

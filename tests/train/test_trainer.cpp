@@ -74,7 +74,7 @@ TEST_CASE("trainer: a NaN loss weight is refused and the last checkpoint kept") 
   CHECK(nn::load_checkpoint<float>(o.checkpoint, model, nullptr).step == 2);  // the last good one
 }
 
-TEST_CASE("trainer: push-forward feeds the model its own history; validation scores a roll-out") {
+TEST_CASE("trainer: push-forward feeds the model its own history, and validation scores a roll-out") {
   const gdsr::Dataset d = gdsr_test::wave_dataset();
   gdsr::TrainOptions o = tiny_train_options();
   o.max_steps = 3;
