@@ -217,19 +217,18 @@ FrameLoss frame_loss(TrainState& s, Sequence& seq, int t, const Points3& chat_tm
   }
   const GdsrOutput<float> out = s.model->forward(seq.graph, in, opt.fine ? &request : nullptr, noise);
   const CoarseLoss<float> coarse = coarse_loss(opt.loss, seq.lr_topo, out.C_hat, seq.lr_truth[t]);
-  FineLoss<float> fine;
-  if (opt.fine && opt.detail_target)
-    fine = fine_loss(opt.loss, batch, out.G,
-                     detail_target(d.corr, d.hr_frames[t], seq.lr_truth[t], gdsr::to_points(out.C_hat), batch.vertices,
-                                   opt.model.frame_eps),
-                     s.image_loss);
-  else if (opt.fine)
-    fine = fine_loss(opt.loss, batch, out.G, d.hr_frames[t], s.image_loss);
   FrameLoss f;
+  f.C_hat = gdsr::to_points(out.C_hat);
+  FineLoss<float> fine;
+  if (opt.fine) {
+    const Points3 target = opt.detail_target ? detail_target(d.corr, d.hr_frames[t], seq.lr_truth[t], f.C_hat,
+                                                             batch.vertices, opt.model.frame_eps)
+                                             : Points3();
+    fine = fine_loss(opt.loss, batch, out.G, opt.detail_target ? target : d.hr_frames[t], s.image_loss);
+  }
   f.total = total_loss(lambdas, coarse.total, fine.total);
   f.coarse = lambdas.coarse * coarse.total.item();
   f.fine = fine.total.defined() ? lambdas.fine * fine.total.item() : 0.0;
-  f.C_hat = gdsr::to_points(out.C_hat);
   f.terms = coarse.log();                   // keys c_position, c_normal, ...
   if (opt.fine) f.terms.merge(fine.log());  // f_position, f_vgg, ...
   if (opt.fine && !noise) {

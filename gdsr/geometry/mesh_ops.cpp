@@ -42,15 +42,6 @@ Pairs to_pairs(const std::vector<std::array<int, 2>>& v) {
   return P;
 }
 
-Csr build_csr(std::vector<std::vector<int>>&& lists) {
-  Csr c;
-  c.offsets.assign(lists.size() + 1, 0);
-  for (size_t v = 0; v < lists.size(); ++v) c.offsets[v + 1] = c.offsets[v] + static_cast<int>(lists[v].size());
-  c.items.reserve(static_cast<size_t>(c.offsets.back()));
-  for (auto& l : lists) c.items.insert(c.items.end(), l.begin(), l.end());
-  return c;
-}
-
 }  // namespace
 
 Points3 face_normals(const Points3& V, const Faces& F) {
@@ -87,6 +78,15 @@ Pairs unique_edges(const Faces& F) {
   std::sort(e.begin(), e.end());
   e.erase(std::unique(e.begin(), e.end()), e.end());
   return to_pairs(e);
+}
+
+Csr build_csr(std::vector<std::vector<int>>&& lists) {
+  Csr c;
+  c.offsets.assign(lists.size() + 1, 0);
+  for (size_t v = 0; v < lists.size(); ++v) c.offsets[v + 1] = c.offsets[v] + static_cast<int>(lists[v].size());
+  c.items.reserve(static_cast<size_t>(c.offsets.back()));
+  for (auto& l : lists) c.items.insert(c.items.end(), l.begin(), l.end());
+  return c;
 }
 
 Csr vertex_faces(const Faces& F, int num_vertices) {

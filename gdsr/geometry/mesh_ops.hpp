@@ -31,6 +31,7 @@ struct Csr {
   std::vector<int> items;
   int count(int v) const { return offsets[v + 1] - offsets[v]; }
 };
+Csr build_csr(std::vector<std::vector<int>>&& lists);      // list v becomes the items of vertex v, in order
 Csr vertex_faces(const Faces& F, int num_vertices);       // faces around each vertex, ascending
 Csr vertex_neighbours(const Faces& F, int num_vertices);  // ring-1 vertices, ascending
 

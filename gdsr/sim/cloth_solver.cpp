@@ -127,14 +127,9 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     bends_.push_back(b);
   }
 
-  std::vector<int>& start = vertex_edges_.offsets;
-  start.assign(m.V.rows() + 1, 0);
-  for (const Edge& e : edges_) ++start[e.i + 1], ++start[e.j + 1];
-  for (int v = 0; v < m.V.rows(); ++v) start[v + 1] += start[v];
-  vertex_edges_.items.resize(start.back());
-  std::vector<int> fill(start.begin(), start.end() - 1);
-  for (int e = 0; e < static_cast<int>(edges_.size()); ++e)
-    vertex_edges_.items[fill[edges_[e].i]++] = e, vertex_edges_.items[fill[edges_[e].j]++] = e;
+  std::vector<std::vector<int>> edges_at(static_cast<size_t>(m.V.rows()));
+  for (int e = 0; e < static_cast<int>(edges_.size()); ++e) edges_at[edges_[e].i].push_back(e), edges_at[edges_[e].j].push_back(e);
+  vertex_edges_ = gdsr::build_csr(std::move(edges_at));
 
   // Body grid for the rest pose; initial push-out; pins.
   const double cell = std::max(0.05, p.contact_radius + p.thickness);
