@@ -63,6 +63,7 @@ struct MakeArgs {
   int iterations = -1, stretch_passes = -1, settle_frames = -1, contact_every = -1, self_detect_every = -1;
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN, self_slack = NAN;
   bool self_collision = true;
+  bool independent_hr = false;  // settle HR from its own placement, not from the settled LR garment
   bool skip_built = false;  // keep --out when it already holds this clip, built and valid
   int rest_blend_frames = 15;
   int raster = 1024;
@@ -88,14 +89,14 @@ struct SimRun {
   double cpu_seconds_per_frame = 0;  // process CPU time
 };
 
-SimRun simulate_one(const MakeArgs& a, double pd, const char* label, const gdsr::BodySequence& body,
-                    const sim::SimParams& params) {
+SimRun simulate_one(sim::Garment garment, const char* label, const gdsr::BodySequence& body,
+                    const sim::SimParams& params, const gdsr::Points3* start = nullptr) {
   SimRun r;
-  r.garment = sim::make_garment(a.garment, pd, body.rest_mesh());
+  r.garment = std::move(garment);
   gdsr::ProgressBar bar(std::string("simulate ") + label + " (" + std::to_string(r.garment.mesh.V.rows()) +
                         " vertices)");
   const double t0 = now_seconds(), c0 = cpu_seconds();
-  r.frames = sim::simulate(r.garment, body, params, bar.callback());
+  r.frames = sim::simulate(r.garment, body, params, bar.callback(), start);
   bar.finish();
   const double steps = static_cast<double>(std::max<size_t>(1, r.frames.size() + params.settle_frames));
   r.seconds_per_frame = (now_seconds() - t0) / steps;
@@ -170,20 +171,24 @@ void run_make(const MakeArgs& a) {
   if (a.self_detect_every > 0) params.self_detect_every = a.self_detect_every;
   if (!std::isnan(a.compression_ratio)) params.compression_ratio = a.compression_ratio;
   params.self_collision = a.self_collision;
-  const SimRun lr = simulate_one(a, a.lr_pd, "LR", body, params);
-  const SimRun hr = simulate_one(a, a.hr_pd, "HR", body, params);
-
+  sim::Garment lr_garment = sim::make_garment(a.garment, a.lr_pd, body.rest_mesh());
+  sim::Garment hr_garment = sim::make_garment(a.garment, a.hr_pd, body.rest_mesh());
   gdsr::Dataset d;
-  d.lr = lr.garment.mesh;
-  d.hr = hr.garment.mesh;
-  d.lr_frames = lr.frames;
-  d.hr_frames = hr.frames;
-  d.body_frames = body.frames;
-  d.body_faces = body.F;
+  d.lr = lr_garment.mesh;
+  d.hr = hr_garment.mesh;
   const double t_corr = now_seconds();
   d.corr = gdsr::compute_correspondence(d.lr, d.hr);
   d.raster = gdsr::rasterize_uv(d.hr.UV, d.hr.FUV, a.raster, a.raster);
   const double corr_seconds = now_seconds() - t_corr;
+
+  const SimRun lr = simulate_one(std::move(lr_garment), "LR", body, params);
+  // Both resolutions start the clip in one drape (see sim::simulate_frames).
+  const gdsr::Points3 hr_start = gdsr::upsample(d.corr, lr.frames.front());
+  const SimRun hr = simulate_one(std::move(hr_garment), "HR", body, params, a.independent_hr ? nullptr : &hr_start);
+  d.lr_frames = lr.frames;
+  d.hr_frames = hr.frames;
+  d.body_frames = body.frames;
+  d.body_faces = body.F;
 
   gdsr::DatasetManifest& m = d.manifest;
   m.garment = a.garment;
@@ -207,6 +212,7 @@ void run_make(const MakeArgs& a) {
                   {"contact_every", params.contact_every},
                   {"settle_damping_1_s", params.settle_damping},
                   {"settle_rest_blend", params.settle_rest_blend},
+                  {"hr_start", a.independent_hr ? "placement" : "settled_lr"},
                   {"self_collision", params.self_collision},
                   {"self_thickness_m", params.self_thickness},
                   {"self_thickness_per_pd", params.self_thickness_per_pd},
@@ -271,6 +277,10 @@ bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why
     }
     if (!sp.contains("solver_revision") || sp["solver_revision"] != sim::kSolverRevision) {
       why = "built by an older solver";
+      return false;
+    }
+    if (sp.value("hr_start", "") != (a.independent_hr ? "placement" : "settled_lr")) {
+      why = "built with another HR start";
       return false;
     }
     gdsr::load_dataset(dir);
@@ -509,7 +519,7 @@ void run_check(const CheckArgs& a) {
 }  // namespace
 
 void add_data_command(CLI::App& app) {
-  CLI::App* data = app.add_subcommand("data", "make, preview, import and check paired LR/HR datasets");
+  CLI::App* data = app.add_subcommand("data", "make, preview, import, check and compare paired LR/HR datasets");
   data->require_subcommand(1);
 
   auto mk = std::make_shared<MakeArgs>();
@@ -561,6 +571,9 @@ void add_data_command(CLI::App& app) {
                    "frames of damped motion on the first pose before frame 0 (default: the solver's)")
       ->check(CLI::Range(0, 1000));
   make->add_flag("!--no-self-collision", mk->self_collision, "switch cloth self-collision off");
+  make->add_flag("--independent-hr", mk->independent_hr,
+                 "settle the HR garment from its own placement instead of from the settled LR garment (solver "
+                 "revision 3; the resolutions then start the clip with their folds in different places)");
   make->add_flag("--skip-built", mk->skip_built,
                  "keep --out if it already holds this clip (garment, motion, range, particle distances), built by "
                  "this solver revision and valid (a recipe always does this)");
@@ -623,4 +636,6 @@ void add_data_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   ch->add_flag("!--no-body", chk->body, "do not measure the body penetration");
   ch->callback([chk]() { run_check(*chk); });
+
+  add_data_compare_command(*data);
 }

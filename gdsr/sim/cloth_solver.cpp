@@ -202,6 +202,16 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
   }
 }
 
+void ClothSolver::set_positions(const Points3& X) {
+  if (X.rows() != x_.rows() || X.cols() != 3 || !X.allFinite())
+    gdsr::fail("sim/cloth_solver", "start positions must be finite, " + std::to_string(x_.rows()) + " x 3");
+  x_ = X;
+  xprev_ = X;
+  v_.setZero();
+  since_detect_ = 1 << 30;
+  tangle_test_due_ = true;
+}
+
 void ClothSolver::set_rest_blend(double a) {
   if (!(a >= 0 && a <= 1)) gdsr::fail("sim/cloth_solver", "rest blend must be in [0, 1]");
   for (size_t c = 0; c < edges_.size(); ++c)
@@ -515,7 +525,8 @@ void ClothSolver::step(const Points3& body_from, const Points3& body_to, double 
 }
 
 std::vector<Points3> simulate_frames(const Garment& g, const gdsr::Faces& body_F, const std::vector<Points3>& frames,
-                                     double fps, const SimParams& p, const gdsr::ProgressFn& progress) {
+                                     double fps, const SimParams& p, const gdsr::ProgressFn& progress,
+                                     const Points3* start) {
   if (frames.empty()) gdsr::fail("sim/cloth_solver", "no body frames");
   if (!(fps > 0)) gdsr::fail("sim/cloth_solver", "fps must be positive");
   for (size_t t = 0; t < frames.size(); ++t)
@@ -530,9 +541,10 @@ std::vector<Points3> simulate_frames(const Garment& g, const gdsr::Faces& body_F
   // the garment fall only ~0.5 g dt^2 (5 mm at 30 fps) per frame, so the clip would start in
   // the placement shape and the fall would happen during the motion, differently at each resolution.
   solver.set_damping(p.settle_damping);
+  if (start) solver.set_positions(*start);
   const double blend_frames = std::max(1.0, p.settle_rest_blend * p.settle_frames);
   for (int k = 0; k < p.settle_frames; ++k) {
-    solver.set_rest_blend(std::min(1.0, (k + 1) / blend_frames));
+    solver.set_rest_blend(start ? 1.0 : std::min(1.0, (k + 1) / blend_frames));
     solver.step(frames[0], frames[0], dt);
     if (progress) progress(++done, total);
   }

@@ -146,6 +146,33 @@ TEST_CASE("cli data: --skip-built keeps a clip built by this solver revision and
   const Run stale = gdsr_run(dir, cmd + " --start 0.1");
   REQUIRE(stale.status == 0);
   CHECK(stale.out.find("built by an older solver") != std::string::npos);
+  // The HR start is part of what was built: an HR settled from its own placement is not kept.
+  CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"hr_start\": \"settled_lr\"") != std::string::npos);
+  const Run independent = gdsr_run(dir, cmd + " --start 0.1 --independent-hr");
+  REQUIRE(independent.status == 0);
+  CHECK(independent.out.find("built with another HR start") != std::string::npos);
+  CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"hr_start\": \"placement\"") != std::string::npos);
+}
+
+TEST_CASE("cli data: compare finds a repeat bit-identical, a nudged twin apart, and refuses other meshes") {
+  TempDir dir("cli_compare");
+  const std::string clip = " --garment skirt_short --seconds 0.2 --hr-pd 0.06 --rest-blend 2 --raster 64"
+                           " --settle-frames 3 --lr-pd ";
+  REQUIRE(gdsr_run(dir, "data make --out '" + (dir / "a") + "'" + clip + "0.08").status == 0);
+  REQUIRE(gdsr_run(dir, "data make --out '" + (dir / "b") + "'" + clip + "0.08").status == 0);
+  REQUIRE(gdsr_run(dir, "data make --out '" + (dir / "c") + "'" + clip + "0.08 --friction 0.2").status == 0);
+  const Run same = gdsr_run(dir, "data compare --a '" + (dir / "a") + "' --b '" + (dir / "b") + "'");
+  REQUIRE(same.status == 0);
+  CHECK(same.out.find("LR: bit-identical over") != std::string::npos);
+  CHECK(same.out.find("HR: bit-identical over") != std::string::npos);
+  const Run twin = gdsr_run(dir, "data compare --a '" + (dir / "a") + "' --b '" + (dir / "c") + "' --every 1");
+  REQUIRE(twin.status == 0);
+  CHECK(twin.out.find("LR: mean") != std::string::npos);
+  CHECK(twin.out.find("HR: mean") != std::string::npos);
+  CHECK(twin.out.find("bit-identical") == std::string::npos);
+  REQUIRE(gdsr_run(dir, "data make --out '" + (dir / "d") + "'" + clip + "0.07").status == 0);
+  check_one_line_error(gdsr_run(dir, "data compare --a '" + (dir / "a") + "' --b '" + (dir / "d") + "'"), "LR frames");
+  check_one_line_error(gdsr_run(dir, "data compare --a '" + (dir / "a") + "' --b '" + (dir / "none") + "'"), "none");
 }
 
 TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out of range are refused") {
