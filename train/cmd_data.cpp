@@ -82,6 +82,9 @@ double cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
+// Where the HR settle started, as the manifest's sim_params.hr_start records it.
+const char* hr_start_name(const MakeArgs& a) { return a.independent_hr ? "placement" : "settled_lr"; }
+
 struct SimRun {
   sim::Garment garment;
   std::vector<gdsr::Points3> frames;
@@ -183,7 +186,7 @@ void run_make(const MakeArgs& a) {
 
   const SimRun lr = simulate_one(std::move(lr_garment), "LR", body, params);
   // Both resolutions start the clip in one drape (see sim::simulate_frames).
-  const gdsr::Points3 hr_start = gdsr::upsample(d.corr, lr.frames.front());
+  const gdsr::Points3 hr_start = a.independent_hr ? gdsr::Points3() : gdsr::upsample(d.corr, lr.frames.front());
   const SimRun hr = simulate_one(std::move(hr_garment), "HR", body, params, a.independent_hr ? nullptr : &hr_start);
   d.lr_frames = lr.frames;
   d.hr_frames = hr.frames;
@@ -212,7 +215,7 @@ void run_make(const MakeArgs& a) {
                   {"contact_every", params.contact_every},
                   {"settle_damping_1_s", params.settle_damping},
                   {"settle_rest_blend", params.settle_rest_blend},
-                  {"hr_start", a.independent_hr ? "placement" : "settled_lr"},
+                  {"hr_start", hr_start_name(a)},
                   {"self_collision", params.self_collision},
                   {"self_thickness_m", params.self_thickness},
                   {"self_thickness_per_pd", params.self_thickness_per_pd},
@@ -279,7 +282,7 @@ bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why
       why = "built by an older solver";
       return false;
     }
-    if (sp.value("hr_start", "") != (a.independent_hr ? "placement" : "settled_lr")) {
+    if (sp.value("hr_start", "") != hr_start_name(a)) {
       why = "built with another HR start";
       return false;
     }
