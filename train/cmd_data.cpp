@@ -159,6 +159,11 @@ void run_make(const MakeArgs& a) {
   std::printf("body: %s, %d frames at %g fps (%d rest blend), %ld vertices, %.1f s\n", a.motion.c_str(),
               body.num_frames(), body.fps, body.rest_blend_frames, static_cast<long>(body.rest_V.rows()),
               now_seconds() - t_body);
+  if (!body.torso_found)
+    std::fprintf(stderr,
+                 "warning: %s: no hips and shoulders found among the skeleton's joint names; the body is a "
+                 "column of capsules without shoulders, neck or waist (gdsr/body/skeleton_body.cpp: classify)\n",
+                 a.motion.c_str());
   std::fflush(stdout);
 
   sim::SimParams params;
@@ -350,7 +355,30 @@ struct PreviewArgs {
   int size = 512;
   bool body = true;
   bool intersections = false;  // paint the faces of intersecting pairs red
+  std::string view = "front";  // where the camera is, relative to the body's first pose (Y-up, facing +z)
 };
+
+// Camera direction and image up of a named view (the camera on the body's side named; the
+// body's left is +x, its front +z; from the top, its front is at the bottom of the image).
+void set_view(const std::string& view, gdsr::RenderOptions& opt) {
+  struct View {
+    const char* name;
+    gdsr::Vec3 dir, up;
+  };
+  const gdsr::Vec3 y(0, 1, 0);
+  const View views[] = {{"front", {0, 0, -1}, y},
+                        {"back", {0, 0, 1}, y},
+                        {"left", {-1, 0, 0}, y},
+                        {"right", {1, 0, 0}, y},
+                        {"top", {0, -1, 0}, {0, 0, -1}}};
+  for (const View& v : views)
+    if (view == v.name) {
+      opt.view_dir = v.dir;
+      opt.up = v.up;
+      return;
+    }
+  gdsr::fail("--view", "'" + view + "' is not one of front, back, left, right, top");
+}
 
 // The garment as two meshes: the faces in no intersecting pair, and those in one (CGAL).
 std::vector<gdsr::TriMesh> split_by_intersections(const gdsr::TriMesh& g, int& marked) {
@@ -380,6 +408,7 @@ void run_preview(const PreviewArgs& a) {
   gdsr::Points3 all = hr.V;
   gdsr::RenderOptions opt;
   opt.width = opt.height = a.size;
+  set_view(a.view, opt);
   const Eigen::RowVector3d lo = all.colwise().minCoeff(), hi = all.colwise().maxCoeff();
   opt.center = (0.5 * (lo + hi)).transpose();
   opt.ortho_half_height = 0.5 * (hi - lo).maxCoeff() * 1.25;
@@ -387,7 +416,8 @@ void run_preview(const PreviewArgs& a) {
   std::vector<gdsr::TriMesh> with_body;
   if (a.body && d.has_body()) with_body.push_back(gdsr::TriMesh{d.body_frames[t], d.body_faces});
   const cv::Vec3b hit_c(40, 40, 220);
-  std::string lr_note, hr_note;
+  const std::string view_note = a.view == "front" ? "" : ", " + a.view;
+  std::string lr_note = view_note, hr_note = view_note;
   auto render = [&](const gdsr::TriMesh& g, const cv::Vec3b& c, std::string& note) {
     std::vector<gdsr::TriMesh> meshes = with_body;
     std::vector<cv::Vec3b> colours(with_body.size(), body_c);
@@ -399,7 +429,7 @@ void run_preview(const PreviewArgs& a) {
           meshes.push_back(parts[k]);
           colours.push_back(k ? hit_c : c);
         }
-      note = ", " + std::to_string(marked) + " faces intersect";
+      note += ", " + std::to_string(marked) + " faces intersect";
     } else {
       meshes.push_back(g);
       colours.push_back(c);
@@ -610,6 +640,9 @@ void add_data_command(CLI::App& app) {
   prev->add_option("--size", pv->size, "pixels per image side")->capture_default_str()->check(CLI::Range(16, 8192));
   prev->add_flag("!--no-body", pv->body, "leave the body out");
   prev->add_flag("--intersections", pv->intersections, "paint faces in self-intersecting pairs (CGAL) red");
+  prev->add_option("--view", pv->view, "camera on the body's front, back, left, right or top")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"front", "back", "left", "right", "top"}));
   prev->callback([pv]() { run_preview(*pv); });
 
   auto imp = std::make_shared<ImportArgs>();

@@ -511,6 +511,7 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
   seq.fps = opt.fps;
   seq.source = path;
   seq.from_skeleton = !clip.skinned;
+  seq.torso_found = clip.skinned || surf.sb.torso_found;
   seq.rest_V = to_out(rest_raw);
   seq.rest_blend_frames = rest_only ? 0 : opt.rest_blend_frames;
   if (!rest_only)

@@ -76,6 +76,9 @@ struct BodySequence {
   Points3 rest_V;              // rest pose vertices x 3 (== frames[0] when rest_blend_frames > 0)
   BodyLandmarks landmarks;     // measured on the rest pose
   bool from_skeleton = false;  // true: body built around a bare skeleton
+  // Skeleton bodies: hips and shoulders recognised by joint name (false: a shoulderless column
+  // of capsules; `gdsr data make` warns). Always true for skinned meshes.
+  bool torso_found = true;
 
   int num_frames() const { return static_cast<int>(frames.size()); }
   TriMesh frame_mesh(int t) const;  // throws on t out of range

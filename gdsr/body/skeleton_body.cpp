@@ -32,12 +32,20 @@ Part classify(const std::string& name) {
   if (has(s, "finger") || has(s, "thumb") || has(s, "index") || has(s, "pinky") || has(s, "ring") || has(s, "middle") ||
       has(s, "endsite") || has(s, "_end"))
     return Part::Skip;
-  if (has(s, "hipjoint")) return Part::Skip;  // root -> hip joint: inside the pelvis
+  // root -> hip joint: inside the pelvis (CMU ASF "LHipJoint", Poser "lButtock")
+  if (has(s, "hipjoint") || has(s, "buttock")) return Part::Skip;
   if (has(s, "hand") || has(s, "wrist")) return Part::Hand;
   if (has(s, "forearm") || has(s, "lowerarm") || has(s, "elbow")) return Part::ForeArm;
+  // Poser / CMU salsa names: "rCollar" (clavicle) then "rShldr" (the upper arm). Unrecognised,
+  // the body had no shoulder joints and its torso became a shoulderless column.
+  if (has(s, "shldr")) return Part::UpperArm;
   if (has(s, "shoulder") || has(s, "clavicle") || has(s, "collar")) return Part::Clavicle;
   if (has(s, "arm")) return Part::UpperArm;
-  if (has(s, "upleg") || has(s, "thigh") || has(s, "upperleg")) return Part::Thigh;
+  // A sided "hip" is the thigh (CMU cgspeed naming, e.g. the 131 walks: "LeftHip" -> "LeftKnee"); the
+  // unsided "Hips" is the pelvis.
+  if (has(s, "upleg") || has(s, "thigh") || has(s, "upperleg") || s == "lefthip" || s == "righthip" ||
+      s == "left_hip" || s == "right_hip")
+    return Part::Thigh;
   if (has(s, "toe")) return Part::Toe;
   if (has(s, "foot") || has(s, "ankle")) return Part::Foot;
   if (has(s, "leg") || has(s, "shin") || has(s, "calf") || has(s, "knee")) return Part::Shin;
@@ -128,6 +136,11 @@ Skeleton analyse(const std::vector<SkelNode>& nodes_in, double mpu) {
     if (nodes_in[i].parent >= 0) children[nodes_in[i].parent].push_back(i);
   std::vector<Part> part(n);
   for (int i = 0; i < n; ++i) part[i] = classify(nodes_in[i].name);
+  // A "shoulder" below a collar is the upper arm (cgspeed: "LeftCollar" -> "LeftShoulder" ->
+  // "LeftElbow"); below the spine it is the clavicle (CMU ASF: "LeftShoulder" -> "LeftArm").
+  for (int i = 0; i < n; ++i)
+    if (part[i] == Part::Clavicle && nodes_in[i].parent >= 0 && part[nodes_in[i].parent] == Part::Clavicle)
+      part[i] = Part::UpperArm;
 
   // Landmarks: thigh starts (hip joints), upper-arm starts (shoulder joints), first neck node.
   std::vector<int> thighs, arms;
@@ -241,8 +254,15 @@ void add_limbs(const Skeleton& sk, const std::vector<SkelNode>& nodes_in, std::v
     const Part pt = part[i];
     if (pt == Part::Skip) continue;
     if (pt == Part::Head) {
-      const int e = farthest_desc(i);
+      int e = farthest_desc(i);
       Vec3 dir = (e != i) ? (P[e] - P[i]).normalized() : up;
+      // The head's end site gives its axis. Eyes alone (Poser / CMU salsa: "leftEye", forward and
+      // to one side, 42 degrees off the neck) would tilt it onto a shoulder: the neck's direction.
+      const int par = nodes_in[i].parent;
+      if (e != i && par >= 0 && (P[i] - P[par]).norm() > 1e-3 && dir.dot((P[i] - P[par]).normalized()) < 0.9) {
+        dir = (P[i] - P[par]).normalized();
+        e = i;
+      }
       Prim p;
       p.ellipsoid = true;
       p.ey = dir;
@@ -250,7 +270,7 @@ void add_limbs(const Skeleton& sk, const std::vector<SkelNode>& nodes_in, std::v
       p.ex = ex.normalized();
       p.ez = p.ex.cross(p.ey);
       p.r = Vec3(0.078, 0.11, 0.095);
-      const Vec3 top = (e != i) ? P[e] : P[i] + up * 0.2;
+      const Vec3 top = (e != i) ? P[e] : P[i] + dir * 0.2;
       p.a = top - dir * 0.105;
       p.owner = i;
       prims.push_back(p);
@@ -448,6 +468,7 @@ SkinnedBody build_skeleton_body(const std::vector<SkelNode>& nodes_in, double mp
   out.V = m.V;
   out.F = m.F;
   to_file_units(out, mpu, nodes_in[0].pos, sk.torso_ok);
+  out.torso_found = sk.torso_ok;
   return out;
 }
 

@@ -27,6 +27,10 @@ struct SkinnedBody {
   // How much taller the body stands with straight vertical legs than at the rest pose
   // (rest poses with spread legs), file units.
   double leg_extra = 0;
+  // Two thighs and two upper arms were recognised by their joint names, so the torso was built
+  // through hips and shoulders. false: the landmarks are height fractions and the torso bones
+  // are round capsules: a column without shoulders, neck or waist.
+  bool torso_found = false;
 };
 
 // metres_per_unit: scale of the file units (radii are in metres); edge: target triangle

@@ -37,7 +37,10 @@ namespace sim {
 // 2: waist curve, pants yoke, self-contact gap and compression scaled with the particle distance.
 // 3: body contacts give way rather than overstretch the cloth (contact_release_stretch).
 // 4: `data make` starts the HR settle from the settled LR garment (simulate_frames' start).
-inline constexpr int kSolverRevision = 4;
+// 5: skeleton bodies read Poser and cgspeed joint names (CMU salsa "rShldr", the 131 walks'
+//    "LeftHip": before, a column with no shoulders, neck or waist) and keep the head upright
+//    (the bodies of 01_01 and 01_03 are unchanged, bit for bit).
+inline constexpr int kSolverRevision = 5;
 
 struct SimParams {
   int substeps = 20;                // per body frame

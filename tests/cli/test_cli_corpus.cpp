@@ -171,6 +171,7 @@ std::vector<Case> corpus() {
       {"data preview --data {d}/ds --frame 999 --out {d}/p.png", "--frame"},
       {"data preview --data {d}/ds --frame -2 --out {d}/p.png", "--frame"},
       {"data preview --data {d}/ds --size 0 --out {d}/p.png", "--size"},
+      {"data preview --data {d}/ds --view side --out {d}/p.png", "--view"},
       {"data preview --data {d}/ds --size 100000 --out {d}/p.png", "--size"},
       {"data preview --data {d}/ds --out {d}/nodir/p.png", "nodir"},
       {"data preview --data {d}/bad --out {d}/p.png", "lr_frames.bin",

@@ -1,9 +1,12 @@
 #include "gdsr/body/body.hpp"
+#include "tests/support/data_fixtures.hpp"
 
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
+#include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 
 using namespace gdsr;
@@ -77,6 +80,62 @@ TEST_CASE("body: BVH skeleton gives a closed human-sized body in motion") {
   CHECK(l.hips.circumference > l.waist.circumference);
   CHECK(l.hips.circumference < 1.2);
   CHECK(l.hips.half_width > l.hips.half_depth);
+}
+
+TEST_CASE("body: every skeleton naming we read gives shoulders, a neck and an upright head") {
+  // CMU salsa clips name their joints the Poser way ("rCollar", "rShldr", "lButtock"), the 131
+  // walks the cgspeed way ("LeftHip" is the thigh, "LeftShoulder" below "LeftCollar" the upper
+  // arm). Until solver revision 5 neither had arms or legs recognised, so the torso was not
+  // built: the body was a shoulderless column (its "neck" 0.9x the chest's girth), and a
+  // t-shirt slid off it.
+  // Also their head's only children are the eyes, 42 degrees off the neck, which tilted the
+  // head onto a shoulder. Measured on the rest pose with measure_section (a convex hull).
+  const std::string shared = GDSR_SHARED_DIR;
+  for (const std::string& path :
+       {kBvhTest, shared + "/motions/cmu-salsa/61_02.bvh", shared + "/motions/cmu-walk/131_01.bvh"}) {
+    CAPTURE(path);
+    BodyOptions o;
+    o.max_seconds = 0.1;
+    BodyLandmarks lm;
+    const TriMesh rest = load_body_rest(path, o, &lm);
+    CHECK(load_body_sequence(path, o).torso_found);
+    const double ax = lm.chest.cx, az = lm.chest.cz;
+    // The neck: the narrowest section between 4 cm above the shoulder joints and the middle
+    // of the head (12 cm below its top); the head: its widest section above the neck.
+    const double top_y = rest.V.col(1).maxCoeff();
+    double neck = 1e9, neck_y = 0, head = 0;
+    for (double y = lm.shoulder_y + 0.04; y < top_y - 0.03; y += 0.005) {
+      const BodySection s = measure_section(rest, y, ax, az, 0.25);
+      if (y < top_y - 0.12 && s.circumference < neck) neck = s.circumference, neck_y = y;
+      if (y > neck_y + 0.05) head = std::max(head, s.circumference);
+    }
+    MESSAGE(path << ": chest " << lm.chest.circumference << " m, neck " << neck << " m at " << neck_y << " m, head "
+                 << head << " m, shoulders at " << lm.shoulder_y << " m");
+    CHECK(neck < 0.55 * lm.chest.circumference);  // the column: 0.9x
+    CHECK(neck < 0.9 * head);                     // a neck, not a tilted head sunk onto it (0.95x)
+    // Upright head: its top straight above the chest's centre.
+    Eigen::Index top = 0;
+    rest.V.col(1).maxCoeff(&top);
+    CHECK(std::hypot(rest.V(top, 0) - ax, rest.V(top, 2) - az) < 0.06);
+  }
+}
+
+TEST_CASE("body: a skeleton whose hips are not recognised says so") {
+  // 01_03 with its thighs renamed: no hips, so no torso through hips and shoulders.
+  std::ifstream in(kBvhTest);
+  REQUIRE(in.good());
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  for (size_t at = text.find("UpLeg"); at != std::string::npos; at = text.find("UpLeg", at))
+    text.replace(at, 5, "Femr");
+  const gdsr_test::TempDir dir("body_names");
+  const std::string renamed = dir / "renamed.bvh";
+  std::ofstream(renamed) << text;
+  BodyOptions o;
+  o.max_seconds = 0.1;
+  CHECK_FALSE(load_body_sequence(renamed, o).torso_found);
+  CHECK(load_body_sequence(kBvhTest, o).torso_found);
 }
 
 TEST_CASE("body: rest blend, resampling and start time are consistent") {

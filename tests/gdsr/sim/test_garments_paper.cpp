@@ -80,10 +80,7 @@ std::vector<int> uv_on_edge(const sim::PatternMesh& pm, const sim::Pattern& p, i
 
 TEST_CASE("garments: the paper's five garments mesh at 30 and 10 mm, weld seams one-to-one, share UV outlines") {
   const gdsr::TriMesh* body = body_0101();
-  if (!body) {
-    MESSAGE("skipped: CMU 01_01 BVH not installed");
-    return;
-  }
+  REQUIRE_MESSAGE(body, "CMU 01_01 BVH not installed (Debian's assimp-testmodels, see scripts/setup.sh)");
   const auto lm = sim::measure_body(*body);
   for (const std::string name : kNew) {
     CAPTURE(name);
@@ -130,10 +127,7 @@ TEST_CASE("garments: the paper's five garments mesh at 30 and 10 mm, weld seams 
 
 TEST_CASE("garments: the paper's five garments rest outside the body, unstrained and free of self-intersections") {
   const gdsr::TriMesh* body = body_0101();
-  if (!body) {
-    MESSAGE("skipped: CMU 01_01 BVH not installed");
-    return;
-  }
+  REQUIRE_MESSAGE(body, "CMU 01_01 BVH not installed (Debian's assimp-testmodels, see scripts/setup.sh)");
   const gdsr::BodyQuery query(*body);
   for (const std::string name : kNew)
     for (const double pd : {0.03, 0.01}) {
@@ -187,10 +181,7 @@ TEST_CASE("garments: the paper's five garments rest outside the body, unstrained
 
 TEST_CASE("garments: the t-shirt sleeves follow the arms, and the t-shirt needs a rest pose with raised arms") {
   const gdsr::TriMesh* body = body_0101();
-  if (!body) {
-    MESSAGE("skipped: CMU 01_01 BVH not installed");
-    return;
-  }
+  REQUIRE_MESSAGE(body, "CMU 01_01 BVH not installed (Debian's assimp-testmodels, see scripts/setup.sh)");
   const auto lm = sim::measure_body(*body);
   for (int k = 0; k < 2; ++k) {
     REQUIRE(lm.arm_found[k]);
@@ -221,10 +212,7 @@ TEST_CASE("garments: the t-shirt sleeves follow the arms, and the t-shirt needs 
 
 TEST_CASE("garments: the paper's garments also fit a salsa dancer's rest pose") {
   const std::string bvh = std::string(GDSR_SHARED_DIR) + "/motions/cmu-salsa/60_02.bvh";
-  if (!std::ifstream(bvh).good()) {
-    MESSAGE("skipped: " << bvh << " not found");
-    return;
-  }
+  REQUIRE_MESSAGE(std::ifstream(bvh).good(), bvh << " is missing (../shared beside the repository)");
   const auto body = gdsr::load_body_rest(bvh);
   const gdsr::BodyQuery query(body);
   for (const std::string name : kNew) {
