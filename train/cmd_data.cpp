@@ -358,26 +358,25 @@ struct PreviewArgs {
   std::string view = "front";  // where the camera is, relative to the body's first pose (Y-up, facing +z)
 };
 
-// Camera direction and image up of a named view (the camera on the body's side named; the
-// body's left is +x, its front +z; from the top, its front is at the bottom of the image).
+// Preview cameras: direction and image up, the camera on the body's side named (the body's
+// left is +x, its front +z; from the top, its front is at the bottom of the image).
+struct View {
+  const char* name;
+  gdsr::Vec3 dir, up;
+};
+const View kViews[] = {{"front", {0, 0, -1}, {0, 1, 0}},
+                       {"back", {0, 0, 1}, {0, 1, 0}},
+                       {"left", {-1, 0, 0}, {0, 1, 0}},
+                       {"right", {1, 0, 0}, {0, 1, 0}},
+                       {"top", {0, -1, 0}, {0, 0, -1}}};
+
+// --view was checked against kViews by the command line.
 void set_view(const std::string& view, gdsr::RenderOptions& opt) {
-  struct View {
-    const char* name;
-    gdsr::Vec3 dir, up;
-  };
-  const gdsr::Vec3 y(0, 1, 0);
-  const View views[] = {{"front", {0, 0, -1}, y},
-                        {"back", {0, 0, 1}, y},
-                        {"left", {-1, 0, 0}, y},
-                        {"right", {1, 0, 0}, y},
-                        {"top", {0, -1, 0}, {0, 0, -1}}};
-  for (const View& v : views)
+  for (const View& v : kViews)
     if (view == v.name) {
       opt.view_dir = v.dir;
       opt.up = v.up;
-      return;
     }
-  gdsr::fail("--view", "'" + view + "' is not one of front, back, left, right, top");
 }
 
 // The garment as two meshes: the faces in no intersecting pair, and those in one (CGAL).
@@ -640,9 +639,11 @@ void add_data_command(CLI::App& app) {
   prev->add_option("--size", pv->size, "pixels per image side")->capture_default_str()->check(CLI::Range(16, 8192));
   prev->add_flag("!--no-body", pv->body, "leave the body out");
   prev->add_flag("--intersections", pv->intersections, "paint faces in self-intersecting pairs (CGAL) red");
+  std::vector<std::string> view_names;
+  for (const View& v : kViews) view_names.push_back(v.name);
   prev->add_option("--view", pv->view, "camera on the body's front, back, left, right or top")
       ->capture_default_str()
-      ->check(CLI::IsMember({"front", "back", "left", "right", "top"}));
+      ->check(CLI::IsMember(view_names));
   prev->callback([pv]() { run_preview(*pv); });
 
   auto imp = std::make_shared<ImportArgs>();

@@ -12,7 +12,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <sstream>
 #include <sys/wait.h>
 
@@ -118,17 +117,13 @@ TEST_CASE("cli data: make a tiny dataset, check it and preview a frame") {
   CHECK(pvi.status == 0);
   CHECK(fs::file_size(dir / "pi.png") > 1000);
   // Other views: the same frame seen from the side and from above is another picture.
-  auto read_bytes = [](const fs::path& f) {
-    std::ifstream in(f, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  };
   for (const std::string view : {"left", "top"}) {
     const fs::path png = dir / ("p_" + view + ".png");
     const Run pvv = gdsr_run(
         dir, "data preview --data '" + out + "' --frame 5 --size 128 --view " + view + " --out '" + png.string() + "'");
     CHECK(pvv.status == 0);
     REQUIRE(fs::exists(png));
-    CHECK(read_bytes(png) != read_bytes(dir / "p.png"));
+    CHECK(gdsr_test::slurp(png.string()) != gdsr_test::slurp(dir / "p.png"));
   }
   check_one_line_error(gdsr_run(dir, "data preview --data '" + out + "' --frame 999 --out '" + (dir / "q.png") + "'"),
                        "out of range");
@@ -142,16 +137,12 @@ TEST_CASE("cli data: make warns when a skeleton's hips and shoulders are not rec
   // CMU 01_01 with its thighs renamed: the body is a column of capsules; data make says so on
   // stderr before anything else (here the skirt then finds no waist on it: a one-line error).
   TempDir dir("cli_make_names");
-  std::string text = gdsr_test::slurp("/usr/share/assimp/models/BVH/01_01.bvh");
-  REQUIRE_MESSAGE(!text.empty(), "assimp-testmodels is not installed (scripts/setup.sh)");
-  for (size_t at = text.find("UpLeg"); at != std::string::npos; at = text.find("UpLeg", at))
-    text.replace(at, 5, "Femr");
-  std::ofstream(dir / "renamed.bvh") << text;
-  const Run mk =
-      gdsr_run(dir, "data make --garment skirt_short --motion '" + (dir / "renamed.bvh") + "' --out '" + (dir / "ds") +
-                        "' --seconds 0.05 --lr-pd 0.1 --hr-pd 0.1 --settle-frames 0 --rest-blend 1 --raster 32");
+  const std::string renamed = gdsr_test::bvh_without_thighs(dir, "/usr/share/assimp/models/BVH/01_01.bvh");
+  REQUIRE_MESSAGE(!renamed.empty(), "assimp-testmodels is not installed (scripts/setup.sh)");
+  const Run mk = gdsr_run(dir, "data make --garment skirt_short --motion '" + renamed + "' --out '" + (dir / "ds") +
+                                   "' --seconds 0.05 --lr-pd 0.1 --hr-pd 0.1 --settle-frames 0 --rest-blend 1 --raster 32");
   CHECK(mk.err.rfind("warning: ", 0) == 0);
-  CHECK(mk.err.find("warning: " + (dir / "renamed.bvh") + ": no hips and shoulders found") != std::string::npos);
+  CHECK(mk.err.find("warning: " + renamed + ": no hips and shoulders found") != std::string::npos);
 }
 
 TEST_CASE("cli data: --skip-built keeps a clip built by this solver revision and rebuilds an older one") {

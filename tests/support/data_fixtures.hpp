@@ -9,6 +9,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <unistd.h>
 
@@ -28,6 +30,22 @@ struct TempDir {
   }
   std::string operator/(const std::string& name) const { return (path / name).string(); }
 };
+
+// A copy of BVH file `bvh` in dir with its thighs renamed ("LeftUpLeg" -> "LeftFemr"), so that
+// no joint name says thigh or hip: the skeleton body cannot find its hips. Returns the path
+// ("" when `bvh` cannot be read).
+inline std::string bvh_without_thighs(const TempDir& dir, const std::string& bvh) {
+  std::ifstream in(bvh);
+  if (!in) return "";
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  for (size_t at = text.find("UpLeg"); at != std::string::npos; at = text.find("UpLeg", at))
+    text.replace(at, 5, "Femr");
+  const std::string out = dir / "renamed.bvh";
+  std::ofstream(out) << text;
+  return out;
+}
 
 // The UV layout of g as a flat mesh (z = 0), as Marvelous Designer exports the pattern.
 inline gdsr::TriMesh flat_uv_mesh(const gdsr::GarmentMesh& g) {

@@ -4,9 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <string>
 
 using namespace gdsr;
@@ -96,18 +94,19 @@ TEST_CASE("body: every skeleton naming we read gives shoulders, a neck and an up
     CAPTURE(path);
     BodyOptions o;
     o.max_seconds = 0.1;
-    BodyLandmarks lm;
-    const TriMesh rest = load_body_rest(path, o, &lm);
-    CHECK(load_body_sequence(path, o).torso_found);
+    const BodySequence s = load_body_sequence(path, o);
+    CHECK(s.torso_found);
+    const TriMesh rest = s.rest_mesh();
+    const BodyLandmarks& lm = s.landmarks;
     const double ax = lm.chest.cx, az = lm.chest.cz;
     // The neck: the narrowest section between 4 cm above the shoulder joints and the middle
     // of the head (12 cm below its top); the head: its widest section above the neck.
     const double top_y = rest.V.col(1).maxCoeff();
     double neck = 1e9, neck_y = 0, head = 0;
     for (double y = lm.shoulder_y + 0.04; y < top_y - 0.03; y += 0.005) {
-      const BodySection s = measure_section(rest, y, ax, az, 0.25);
-      if (y < top_y - 0.12 && s.circumference < neck) neck = s.circumference, neck_y = y;
-      if (y > neck_y + 0.05) head = std::max(head, s.circumference);
+      const BodySection sec = measure_section(rest, y, ax, az, 0.25);
+      if (y < top_y - 0.12 && sec.circumference < neck) neck = sec.circumference, neck_y = y;
+      if (y > neck_y + 0.05) head = std::max(head, sec.circumference);
     }
     MESSAGE(path << ": chest " << lm.chest.circumference << " m, neck " << neck << " m at " << neck_y << " m, head "
                  << head << " m, shoulders at " << lm.shoulder_y << " m");
@@ -122,16 +121,9 @@ TEST_CASE("body: every skeleton naming we read gives shoulders, a neck and an up
 
 TEST_CASE("body: a skeleton whose hips are not recognised says so") {
   // 01_03 with its thighs renamed: no hips, so no torso through hips and shoulders.
-  std::ifstream in(kBvhTest);
-  REQUIRE(in.good());
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
-  for (size_t at = text.find("UpLeg"); at != std::string::npos; at = text.find("UpLeg", at))
-    text.replace(at, 5, "Femr");
   const gdsr_test::TempDir dir("body_names");
-  const std::string renamed = dir / "renamed.bvh";
-  std::ofstream(renamed) << text;
+  const std::string renamed = gdsr_test::bvh_without_thighs(dir, kBvhTest);
+  REQUIRE(!renamed.empty());
   BodyOptions o;
   o.max_seconds = 0.1;
   CHECK_FALSE(load_body_sequence(renamed, o).torso_found);
