@@ -308,6 +308,67 @@ std::vector<Trs> pose_at(const Clip& c, double seconds) {
   return L;
 }
 
+// The skeleton: every node below the top animated ancestor of the first animated node,
+// parents first, at the pose of globals G (file units), with each one's index in the rig.
+struct SkeletonNodes {
+  std::vector<detail::SkelNode> nodes;
+  std::vector<int> to_rig;
+};
+
+SkeletonNodes skeleton_nodes(const Rig& rig, const std::vector<Mat4>& G, const std::string& path) {
+  const size_t nn = rig.node.size();
+  int root = -1;
+  for (size_t i = 0; i < nn && root < 0; ++i)
+    if (rig.channel[i]) root = static_cast<int>(i);
+  if (root < 0) gdsr::fail("load_body_sequence: " + path, "no animated node (no skeleton)");
+  while (rig.parent[root] >= 0 && rig.channel[rig.parent[root]]) root = rig.parent[root];
+  SkeletonNodes out;
+  std::map<int, int> from_rig;
+  for (size_t i = root; i < nn; ++i) {
+    const int p = rig.parent[i];
+    if (static_cast<int>(i) != root && !from_rig.count(p)) continue;
+    from_rig[static_cast<int>(i)] = static_cast<int>(out.nodes.size());
+    out.to_rig.push_back(static_cast<int>(i));
+    detail::SkelNode sn;
+    sn.name = rig.node[i]->mName.C_Str();
+    sn.parent = static_cast<int>(i) == root ? -1 : from_rig[p];
+    sn.pos = G[i].topRightCorner<3, 1>();
+    out.nodes.push_back(sn);
+  }
+  return out;
+}
+
+// A rest pose with the arms hanging down (the CMU 131 walks) would fuse the arms to the
+// body's sides when it is built, and give garments a waist as wide as the elbows. Each upper
+// arm more than 60 degrees below the horizontal is turned about its shoulder to point
+// sideways, level: a T-pose. T- and A-poses are left exactly as they are.
+void raise_hanging_arms(Rig& rig, const std::string& path) {
+  const std::vector<Mat4> G = rig.globals(rig.rest);
+  const SkeletonNodes sn = skeleton_nodes(rig, G, path);
+  const std::vector<int> arms = detail::upper_arm_starts(sn.nodes);
+  if (arms.size() != 2) return;
+  const Vec3 mid = 0.5 * (sn.nodes[arms[0]].pos + sn.nodes[arms[1]].pos);
+  for (int a : arms) {
+    const Vec3 shoulder = sn.nodes[a].pos;
+    int elbow = -1;  // the child farthest from the shoulder
+    for (size_t k = 0; k < sn.nodes.size(); ++k)
+      if (sn.nodes[k].parent == a &&
+          (elbow < 0 || (sn.nodes[k].pos - shoulder).norm() > (sn.nodes[elbow].pos - shoulder).norm()))
+        elbow = static_cast<int>(k);
+    if (elbow < 0 || (sn.nodes[elbow].pos - shoulder).norm() < 1e-9) continue;
+    const Vec3 arm = (sn.nodes[elbow].pos - shoulder).normalized();
+    Vec3 side = shoulder - mid;
+    side.y() = 0;
+    if (arm.y() > -std::sin(60 * M_PI / 180) || side.norm() < 1e-9) continue;
+    // Global rotation Q about the shoulder: the local rotation becomes Rp^-1 Q Rp r.
+    const Quat Q = Quat::FromTwoVectors(arm, side.normalized());
+    const int r = sn.to_rig[a], par = rig.parent[r];
+    const Mat4& Gp = par >= 0 ? G[par] : rig.pre;
+    const Eigen::Matrix3d Rp = Gp.topLeftCorner<3, 3>();
+    rig.rest[r].r = Quat(Rp.inverse() * Q.toRotationMatrix() * Rp * rig.rest[r].r.toRotationMatrix()).normalized();
+  }
+}
+
 // The body surface with its skin: the file's skinned meshes, or a body built around the
 // skeleton (sb, and shape_to_rest: the skeleton body's landmark space -> rest pose).
 struct Surface {
@@ -325,34 +386,16 @@ Surface build_surface(const aiScene* s, const Clip& c, const std::vector<Mat4>& 
     weld(out.sk, out.sk.apply(G_rest));
     return out;
   }
-  // Skeleton: every node below the top animated ancestor of the first animated node.
-  const size_t nn = rig.node.size();
-  int root = -1;
-  for (size_t i = 0; i < nn && root < 0; ++i)
-    if (rig.channel[i]) root = static_cast<int>(i);
-  if (root < 0) gdsr::fail("load_body_sequence: " + path, "no animated node (no skeleton)");
-  while (rig.parent[root] >= 0 && rig.channel[rig.parent[root]]) root = rig.parent[root];
   // The body is built at the file's rest pose with its own root translation, so the same
   // skeleton always gives the same mesh whatever start_seconds is.
   const std::vector<Mat4> G_shape = rig.globals(rig.rest);
-  out.shape_to_rest = G_rest[root] * G_shape[root].inverse();
-  std::vector<detail::SkelNode> nodes;
-  std::vector<int> to_rig;
-  std::map<int, int> from_rig;
-  for (size_t i = root; i < nn; ++i) {
-    const int p = rig.parent[i];
-    if (static_cast<int>(i) != root && !from_rig.count(p)) continue;
-    from_rig[static_cast<int>(i)] = static_cast<int>(nodes.size());
-    to_rig.push_back(static_cast<int>(i));
-    detail::SkelNode sn;
-    sn.name = rig.node[i]->mName.C_Str();
-    sn.parent = static_cast<int>(i) == root ? -1 : from_rig[p];
-    sn.pos = G_shape[i].topRightCorner<3, 1>();
-    nodes.push_back(sn);
-  }
+  const SkeletonNodes sn = skeleton_nodes(rig, G_shape, path);
+  const std::vector<detail::SkelNode>& nodes = sn.nodes;
+  const std::vector<int>& to_rig = sn.to_rig;
+  out.shape_to_rest = G_rest[to_rig[0]] * G_shape[to_rig[0]].inverse();
   if (nodes.size() < 3) gdsr::fail("load_body_sequence: " + path, "skeleton has fewer than 3 joints");
   double ymin = 1e300, ymax = -1e300;
-  for (auto& sn : nodes) ymin = std::min(ymin, sn.pos.y()), ymax = std::max(ymax, sn.pos.y());
+  for (const auto& n : nodes) ymin = std::min(ymin, n.pos.y()), ymax = std::max(ymax, n.pos.y());
   if (!(ymax - ymin > 0)) gdsr::fail("load_body_sequence: " + path, "skeleton has zero height at the rest pose");
   const double mpu = opt.height / ((ymax - ymin) * 1.04);
   out.sb = detail::build_skeleton_body(nodes, mpu, opt.body_edge);
@@ -486,7 +529,8 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
   if (!s || !s->mRootNode)
     gdsr::fail("load_body_sequence: " + path, std::string("assimp cannot read it: ") + imp.GetErrorString());
 
-  const Clip clip = read_clip(s, path, opt);
+  Clip clip = read_clip(s, path, opt);
+  if (!clip.skinned) raise_hanging_arms(clip.rig, path);
   if (opt.start_seconds > clip.duration)
     gdsr::fail("load_body_sequence: " + path,
                "start_seconds beyond the clip length " + std::to_string(clip.duration) + " s");

@@ -7,6 +7,8 @@
 //   at the rest pose (smooth union of tapered/elliptic capsules and ellipsoids, meshed by
 //   marching tetrahedra + CGAL isotropic remeshing: closed, manifold, outward normals,
 //   deterministic) and skinned to the bones (<= 4 per vertex, by distance to the parts).
+//   Upper arms hanging more than 60 degrees below the horizontal in the file's rest pose are
+//   first raised level at the shoulder (a T-pose); the motion itself is not changed.
 //
 // Output coordinates: metres, y up. Every body is scaled uniformly so that its rest pose is
 // opt.height tall (y extent; for skeleton bodies counting the legs as vertical, so a rest

@@ -440,6 +440,11 @@ void to_file_units(SkinnedBody& out, double mpu, const Vec3& origin, bool torso_
 
 }  // namespace
 
+std::vector<int> upper_arm_starts(const std::vector<SkelNode>& nodes) {
+  if (nodes.size() < 2) return {};
+  return analyse(nodes, 1.0).arms;
+}
+
 SkinnedBody build_skeleton_body(const std::vector<SkelNode>& nodes_in, double mpu, double edge) {
   if (nodes_in.size() < 2) gdsr::fail("build_skeleton_body", "skeleton has fewer than 2 nodes");
   const Skeleton sk = analyse(nodes_in, mpu);

@@ -33,6 +33,9 @@ struct SkinnedBody {
   bool torso_found = false;
 };
 
+// The nodes that start the upper arms, recognised by name as build_skeleton_body does.
+std::vector<int> upper_arm_starts(const std::vector<SkelNode>& nodes);
+
 // metres_per_unit: scale of the file units (radii are in metres); edge: target triangle
 // circumradius, metres. Throws if the skeleton has no recognisable body (fewer than 2 nodes).
 SkinnedBody build_skeleton_body(const std::vector<SkelNode>& nodes, double metres_per_unit, double edge);

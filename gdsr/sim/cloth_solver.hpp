@@ -40,7 +40,9 @@ namespace sim {
 // 5: skeleton bodies read Poser and cgspeed joint names (CMU salsa "rShldr", the 131 walks'
 //    "LeftHip": before, a column with no shoulders, neck or waist) and keep the head upright
 //    (the bodies of 01_01 and 01_03 are unchanged, bit for bit).
-inline constexpr int kSolverRevision = 5;
+// 6: skeleton bodies whose rest pose has the arms hanging down (the 131 walks) are built with
+//    the arms level, a T-pose (01_01, 01_03 and the salsa bodies are unchanged, bit for bit).
+inline constexpr int kSolverRevision = 6;
 
 struct SimParams {
   int substeps = 20;                // per body frame

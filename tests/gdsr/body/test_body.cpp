@@ -1,4 +1,5 @@
 #include "gdsr/body/body.hpp"
+#include "gdsr/sim/body_landmarks.hpp"
 #include "tests/support/data_fixtures.hpp"
 
 #include <doctest/doctest.h>
@@ -117,6 +118,29 @@ TEST_CASE("body: every skeleton naming we read gives shoulders, a neck and an up
     rest.V.col(1).maxCoeff(&top);
     CHECK(std::hypot(rest.V(top, 0) - ax, rest.V(top, 2) - az) < 0.06);
   }
+}
+
+TEST_CASE("body: a rest pose with the arms hanging down is built in a T-pose") {
+  // The 131 walks' rest pose has the arms down along the sides. Built there, the arms were
+  // fused to the trunk and the garments' waist (sim::measure_body) took them in: 0.25 m from
+  // the axis against 0.16 m for 01_03, so the short skirt had 5,032 LR vertices instead of
+  // about 930. Since solver revision 6 each hanging upper arm is turned level at its shoulder.
+  BodyOptions o;
+  o.max_seconds = 0.1;
+  const BodySequence walk = load_body_sequence(std::string(GDSR_SHARED_DIR) + "/motions/cmu-walk/131_01.bvh", o);
+  const BodySequence ref = load_body_sequence(kBvhTest, o);  // rest pose already a T-pose
+  const sim::BodyLandmarks lw = sim::measure_body(walk.rest_mesh()), lr = sim::measure_body(ref.rest_mesh());
+  MESSAGE("waist from the axis: 131_01 " << lw.waist_r << " m, 01_03 " << lr.waist_r << " m");
+  CHECK(lw.waist_r < 1.2 * lr.waist_r);
+  CHECK(lw.waist_r > 0.8 * lr.waist_r);
+  // Arms level: the rest pose spans about an arm span sideways, at shoulder height.
+  const double span = walk.rest_V.col(0).maxCoeff() - walk.rest_V.col(0).minCoeff();
+  const double ref_span = ref.rest_V.col(0).maxCoeff() - ref.rest_V.col(0).minCoeff();
+  MESSAGE("rest pose width: 131_01 " << span << " m, 01_03 " << ref_span << " m");
+  CHECK(span > 0.85 * ref_span);
+  // The motion itself is untouched: after the blend from rest, the arms hang down again.
+  const Points3& last = walk.frames.back();
+  CHECK(last.col(0).maxCoeff() - last.col(0).minCoeff() < 0.75 * span);
 }
 
 TEST_CASE("body: a skeleton whose hips are not recognised says so") {
