@@ -176,6 +176,18 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     for (int v = 0; v < nv; ++v) fixed[v] = winv_[v] == 0;
     implicit_bending_ = std::make_unique<ImplicitBending>(nv, stencils, mass_, fixed);
   }
+  // Cloth that hangs from a pin: connected to one through the mesh (see overstretched_at).
+  anchored_.assign(nv, 0);
+  std::vector<int> reached(g.pinned.begin(), g.pinned.end());
+  for (int v : reached) anchored_[v] = 1;
+  for (size_t k = 0; k < reached.size(); ++k) {
+    const int v = reached[k];
+    for (int j = vertex_edges_.offsets[v]; j < vertex_edges_.offsets[v + 1]; ++j) {
+      const Edge& e = edges_[vertex_edges_.items[j]];
+      const int u = e.i == v ? e.j : e.i;
+      if (!anchored_[u]) anchored_[u] = 1, reached.push_back(u);
+    }
+  }
   if (!g.pinned.empty() && p.tethers) {
     if (!(p.tether_stretch >= 0)) gdsr::fail("sim/cloth_solver", "tether_stretch must be >= 0");
     tethers_ = make_tethers(m, g.pinned);
@@ -422,6 +434,7 @@ void ClothSolver::solve_layers() {
 }
 
 bool ClothSolver::overstretched_at(int v, const Vec3& x) const {
+  if (!anchored_[v]) return false;
   const double limit = p_.contact_release_stretch;
   for (int k = vertex_edges_.offsets[v]; k < vertex_edges_.offsets[v + 1]; ++k) {
     const Edge& e = edges_[vertex_edges_.items[k]];
