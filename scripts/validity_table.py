@@ -23,6 +23,8 @@ def row(name, res, v, stats):
     if body and "pinch_frames" in body:
         pen += (f' / {1000 * body["max_penetration_outside_pinches_m"]:.1f} '
                 f'({body["frames_over_limit_outside_pinches"]}) / {body["pinch_frames"]}')
+    if body and "pinch_frames_in_body_crossings" in body:
+        pen += f' ({body["pinch_frames_in_body_crossings"]} where the body crosses itself, in {v["body_crossing_frames"]} frames)'
     cpu = stats.get(f"{res}_cpu_seconds_per_frame")
     wall = stats.get(f"{res}_seconds_per_frame")
     speed = f"{wall:.3f} / {cpu:.3f}" if wall is not None and cpu is not None else "-"

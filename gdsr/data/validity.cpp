@@ -92,7 +92,21 @@ Depths penetration(const BodyQuery& body, const Points3& body_rest, const Points
   return d;
 }
 
-void add_penetration(const Depths& d, int t, double limit, ResolutionValidity& r) {
+// Two body faces intersect (CGAL) whose vertices were all farther than sep apart in the first
+// frame, rest: two parts, one inside the other (validity.hpp).
+bool body_crosses_itself(const Points3& V, const Faces& F, const Points3& rest, double sep) {
+  const SelfIntersections si = self_intersections(V, F, /*list_pairs=*/true);
+  const double sep2 = sep * sep;
+  for (const auto& [f, g] : si.list) {
+    bool apart = true;
+    for (int a = 0; a < 3 && apart; ++a)
+      for (int b = 0; b < 3 && apart; ++b) apart = (rest.row(F(f, a)) - rest.row(F(g, b))).squaredNorm() > sep2;
+    if (apart) return true;
+  }
+  return false;
+}
+
+void add_penetration(const Depths& d, int t, double limit, bool body_crossing, ResolutionValidity& r) {
   if (d.all > r.max_penetration) {  // the frame stays -1 while nothing penetrates
     r.max_penetration = d.all;
     r.max_penetration_frame = t;
@@ -104,6 +118,7 @@ void add_penetration(const Depths& d, int t, double limit, ResolutionValidity& r
   r.frames_over_limit += d.all > limit;
   r.frames_over_limit_free += d.free > limit;
   r.pinch_frames += d.pinched > limit;
+  r.pinch_frames_in_body_crossings += body_crossing && d.pinched > limit;
 }
 
 double mean_distance(const Points3& a, const Points3& b) {
@@ -159,8 +174,10 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
       else
         body->update(d.body_frames[t]);
       const Points3& rest = d.body_frames[0];
-      add_penetration(penetration(*body, rest, d.lr_frames[t], opt), t, opt.penetration_limit, v.lr);
-      add_penetration(penetration(*body, rest, d.hr_frames[t], opt), t, opt.penetration_limit, v.hr);
+      const bool crossing = body_crosses_itself(d.body_frames[t], d.body_faces, rest, opt.pinch_separation);
+      v.body_crossing_frames += crossing;
+      add_penetration(penetration(*body, rest, d.lr_frames[t], opt), t, opt.penetration_limit, crossing, v.lr);
+      add_penetration(penetration(*body, rest, d.hr_frames[t], opt), t, opt.penetration_limit, crossing, v.hr);
     }
     if (progress) progress(t + 1, steps);
   }
@@ -195,7 +212,8 @@ nlohmann::json resolution_json(const ResolutionValidity& r, bool body) {
                  {"max_penetration_outside_pinches_m", r.max_penetration_free},
                  {"max_penetration_outside_pinches_frame", r.max_penetration_free_frame},
                  {"frames_over_limit_outside_pinches", r.frames_over_limit_free},
-                 {"pinch_frames", r.pinch_frames}};
+                 {"pinch_frames", r.pinch_frames},
+                 {"pinch_frames_in_body_crossings", r.pinch_frames_in_body_crossings}};
   return j;
 }
 
@@ -237,6 +255,9 @@ ResolutionValidity resolution_from_json(const nlohmann::json& j, bool body, cons
         split ? take<int>(b, "max_penetration_outside_pinches_frame", where + "body.") : r.max_penetration_frame;
     r.frames_over_limit_free = split ? take<int>(b, "frames_over_limit_outside_pinches", where + "body.") : r.frames_over_limit;
     r.pinch_frames = split ? take<int>(b, "pinch_frames", where + "body.") : 0;
+    // ... and before the body's own crossings were counted: unknown.
+    r.pinch_frames_in_body_crossings =
+        b.contains("pinch_frames_in_body_crossings") ? take<int>(b, "pinch_frames_in_body_crossings", where + "body.") : -1;
   }
   return r;
 }
@@ -244,18 +265,20 @@ ResolutionValidity resolution_from_json(const nlohmann::json& j, bool body, cons
 }  // namespace
 
 nlohmann::json validity_to_json(const ValidityFigures& v) {
-  return {{"frames", v.frames},
-          {"intersection_stride", v.intersection_stride},
-          {"penetration_limit_m", v.penetration_limit},
-          {"body_measured", v.body_measured},
-          {"lr", resolution_json(v.lr, v.body_measured)},
-          {"hr", resolution_json(v.hr, v.body_measured)},
-          {"agreement_m",
-           {{"mean", v.agreement_mean},
-            {"max_frame_mean", v.agreement_max},
-            {"max_frame", v.agreement_max_frame},
-            {"rest", v.agreement_rest}}},
-          {"lr_upsampled_mean_curvature_1_m", v.upsampled_mean_curvature}};
+  nlohmann::json j = {{"frames", v.frames},
+                      {"intersection_stride", v.intersection_stride},
+                      {"penetration_limit_m", v.penetration_limit},
+                      {"body_measured", v.body_measured},
+                      {"lr", resolution_json(v.lr, v.body_measured)},
+                      {"hr", resolution_json(v.hr, v.body_measured)},
+                      {"agreement_m",
+                       {{"mean", v.agreement_mean},
+                        {"max_frame_mean", v.agreement_max},
+                        {"max_frame", v.agreement_max_frame},
+                        {"rest", v.agreement_rest}}},
+                      {"lr_upsampled_mean_curvature_1_m", v.upsampled_mean_curvature}};
+  if (v.body_measured) j["body_crossing_frames"] = v.body_crossing_frames;
+  return j;
 }
 
 ValidityFigures validity_from_json(const nlohmann::json& j) {
@@ -264,6 +287,7 @@ ValidityFigures validity_from_json(const nlohmann::json& j) {
   v.intersection_stride = take<int>(j, "intersection_stride", "");
   v.penetration_limit = take<double>(j, "penetration_limit_m", "");
   v.body_measured = take<bool>(j, "body_measured", "");
+  v.body_crossing_frames = j.contains("body_crossing_frames") ? take<int>(j, "body_crossing_frames", "") : -1;
   v.lr = resolution_from_json(take<nlohmann::json>(j, "lr", ""), v.body_measured, "lr.");
   v.hr = resolution_from_json(take<nlohmann::json>(j, "hr", ""), v.body_measured, "hr.");
   const auto a = take<nlohmann::json>(j, "agreement_m", "");
@@ -330,6 +354,11 @@ std::string validity_table(const ValidityFigures& v) {
     line("  body: outside pinches: frames > %-7s %14d %14d\n", mm.c_str(), v.lr.frames_over_limit_free,
          v.hr.frames_over_limit_free);
     line("  body: pinch frames (2nd part, > %-7s %14d %14d\n", (mm + ")").c_str(), v.lr.pinch_frames, v.hr.pinch_frames);
+    if (v.body_crossing_frames >= 0) {
+      line("  %-40s %14d\n", "body: frames it crosses itself (2 parts)", v.body_crossing_frames);
+      line("  %-40s %14d %14d\n", "  pinch frames among them", v.lr.pinch_frames_in_body_crossings,
+           v.hr.pinch_frames_in_body_crossings);
+    }
   } else {
     line("  %-40s %14s %14s\n", "body: penetration", "not measured", "(no body)");
   }

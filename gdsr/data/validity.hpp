@@ -10,6 +10,10 @@
 //     vertex is "pinched" when a second body part is within pinch_reach of it (a body vertex
 //     farther than pinch_separation, in the first frame, from the closest point): cloth
 //     between a hand and a hip cannot be outside both, so pinched frames are counted apart;
+//     and the body's own crossings: frames where two body faces intersect (CGAL) whose
+//     vertices were all farther than pinch_separation apart in the first frame (two parts:
+//     a mocap forearm passing into the trunk; the skin creasing at a bent joint does not
+//     count), and the pinch frames among them (the motion leaves the cloth no room);
 //   - agreement: distance of each HR vertex to the LR frame upsampled to HR topology through
 //     the dataset's correspondence (gdsr/geometry/correspondence.hpp);
 //   - wrinkles: mean absolute mean curvature of HR, LR upsampled and LR
@@ -59,6 +63,7 @@ struct ResolutionValidity {
   int max_penetration_free_frame = -1;
   int frames_over_limit_free = 0;
   int pinch_frames = 0;  // frames where a pinched vertex is deeper than the limit
+  int pinch_frames_in_body_crossings = 0;  // of those, frames where the body crosses itself (-1: not measured)
   double mean_curvature = 0;       // 1/m, mean over frames
 };
 
@@ -67,6 +72,7 @@ struct ValidityFigures {
   int intersection_stride = 1;
   double penetration_limit = 0.005;  // metres
   bool body_measured = false;
+  int body_crossing_frames = 0;  // frames where two body parts intersect (see above; -1: not measured)
   ResolutionValidity lr, hr;
   // agreement: per frame, the mean over HR vertices of |HR - upsample(LR)|, metres
   double agreement_mean = 0;  // averaged over the clip

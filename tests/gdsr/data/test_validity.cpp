@@ -144,6 +144,54 @@ TEST_CASE("gdsr: validity counts penetration under a second body part as a pinch
   CHECK_THROWS_AS(gdsr::measure_validity(d, opt), gdsr::Error);
 }
 
+TEST_CASE("gdsr: validity counts the frames where the body crosses itself, and the pinches among them") {
+  // The rising box of the tests above plus two more parts, 0.4-0.5 m away in frame 0: a "hand"
+  // that hovers 1 cm above the sheet in frame 2 (a pinch, the body not crossing itself), and an
+  // "arm" that in frame 3 is pushed 1 cm into the body box's side below the sheet (the body
+  // crosses itself; the LR vertex 3 mm deep there is pinched by it).
+  const std::vector<double> top = {0.001, 0.004, 0.008, 0.003};
+  gdsr::Dataset d = stretched_dataset(top);
+  const gdsr::TriMesh hand_far = box(0.6, 0.65, 0.13, 0.17, 0.01, 0.05),
+                      hand_near = box(0.14, 0.19, 0.13, 0.17, 0.01, 0.05),
+                      arm_far = box(0.7, 0.8, 0.13, 0.17, -0.03, -0.005),
+                      arm_in = box(0.19, 0.29, 0.13, 0.17, -0.03, -0.005);
+  gdsr::Faces F(36, 3);
+  F << d.body_faces, (hand_far.F.array() + 8).matrix(), (arm_far.F.array() + 16).matrix();
+  d.body_faces = F;
+  for (size_t t = 0; t < d.body_frames.size(); ++t) {
+    Points3 V(24, 3);
+    V << d.body_frames[t], (t == 2 ? hand_near : hand_far).V, (t == 3 ? arm_in : arm_far).V;
+    d.body_frames[t] = V;
+  }
+  gdsr::ValidityOptions opt;
+  opt.penetration_limit = 0.0025;
+  const gdsr::ValidityFigures v = gdsr::measure_validity(d, opt);
+  CHECK(v.body_crossing_frames == 1);  // frame 3 only
+  CHECK(v.lr.pinch_frames == 2);       // frames 2 (8 mm, the hand) and 3 (3 mm, the arm)
+  CHECK(v.lr.pinch_frames_in_body_crossings == 1);
+  CHECK(v.hr.pinch_frames == 1);  // HR is 2 mm higher: 6 mm in frame 2, 1 mm in frame 3
+  CHECK(v.hr.pinch_frames_in_body_crossings == 0);
+  // Parts that touched in frame 0 are one part: the same crossing no longer counts (a joint's
+  // skin creasing as it bends).
+  gdsr::Dataset close = d;
+  close.body_frames[0].block(16, 0, 8, 3) = arm_in.V;
+  close.body_frames[0].block(16, 0, 8, 1).array() += 0.02;  // 1 cm clear of the body box
+  CHECK(gdsr::measure_validity(close, opt).body_crossing_frames == 0);
+  // Survives the manifest and is printed; manifests without the keys read -1 ("not measured").
+  const nlohmann::json j = gdsr::validity_to_json(v);
+  const gdsr::ValidityFigures back = gdsr::validity_from_json(j);
+  CHECK(back.body_crossing_frames == 1);
+  CHECK(back.lr.pinch_frames_in_body_crossings == 1);
+  CHECK(gdsr::validity_table(v).find("crosses itself") != std::string::npos);
+  nlohmann::json old = j;
+  old.erase("body_crossing_frames");
+  old["lr"]["body"].erase("pinch_frames_in_body_crossings");
+  const gdsr::ValidityFigures o = gdsr::validity_from_json(old);
+  CHECK(o.body_crossing_frames == -1);
+  CHECK(o.lr.pinch_frames_in_body_crossings == -1);
+  CHECK(gdsr::validity_table(o).find("crosses itself") == std::string::npos);
+}
+
 TEST_CASE("gdsr: validity counts the HR frames that overlap themselves, on every k-th frame") {
   gdsr::Dataset d = gdsr_test::wave_dataset(4);
   // Frame 2: the HR sheet wrapped 1.25 times round a cylinder, so a quarter lies on itself.
