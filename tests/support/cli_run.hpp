@@ -7,8 +7,6 @@
 #include <doctest/doctest.h>
 
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <sys/wait.h>
 
@@ -18,13 +16,6 @@ struct Run {
   int status = -1;
   std::string out, err;
 };
-
-inline std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // `prefix` runs before the binary (e.g. a command that drops privileges).
 inline Run gdsr_run(const TempDir& dir, const std::string& args, const std::string& prefix = "") {

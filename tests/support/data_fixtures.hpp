@@ -31,15 +31,20 @@ struct TempDir {
   std::string operator/(const std::string& name) const { return (path / name).string(); }
 };
 
+// The whole file at path ("" when it cannot be read).
+inline std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
 // A copy of BVH file `bvh` in dir with its thighs renamed ("LeftUpLeg" -> "LeftFemr"), so that
 // no joint name says thigh or hip: the skeleton body cannot find its hips. Returns the path
 // ("" when `bvh` cannot be read).
 inline std::string bvh_without_thighs(const TempDir& dir, const std::string& bvh) {
-  std::ifstream in(bvh);
-  if (!in) return "";
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
+  if (!std::ifstream(bvh)) return "";
+  std::string text = slurp(bvh);
   for (size_t at = text.find("UpLeg"); at != std::string::npos; at = text.find("UpLeg", at))
     text.replace(at, 5, "Femr");
   const std::string out = dir / "renamed.bvh";
