@@ -72,7 +72,8 @@ GradCheckResult gradcheck(const std::function<Tensord(const std::vector<Tensord>
       std::shuffle(entries.begin(), entries.end(), rng);
       entries.resize(static_cast<size_t>(opt.max_entries_per_input));
     }
-    const std::vector<double> analytic = x.has_grad() ? x.grad() : std::vector<double>(static_cast<size_t>(n), 0.0);
+    const std::vector<double> analytic =
+        x.has_grad() ? std::vector<double>(x.grad().begin(), x.grad().end()) : std::vector<double>(size_t(n), 0.0);
 
     // Groups judged together: the whole input, or each column of a 2-D input.
     const int64_t cols = opt.per_column && x.dim() == 2 ? x.cols() : 1;

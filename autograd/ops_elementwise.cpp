@@ -65,7 +65,7 @@ Broadcast broadcast(const char* op, const Shape& sa, const Shape& sb) {
 template <class T, class F, class DA, class DB>
 Tensor<T> binary_op(const char* name, const Tensor<T>& a, const Tensor<T>& b, F f, DA da, DB db) {
   const Broadcast bc = broadcast(name, a.shape(), b.shape());
-  Tensor<T> out = new_output<T>(bc.out_shape);
+  Tensor<T> out = new_output_overwritten<T>(bc.out_shape);  // every element written below
   const T* av = a.data();
   const T* bv = b.data();
   T* ov = out.data();
@@ -109,7 +109,7 @@ Tensor<T> binary_op(const char* name, const Tensor<T>& a, const Tensor<T>& b, F 
 
 // f(x) -> value; df(x, y) -> dy/dx.
 template <class T, class F, class DF> Tensor<T> unary_op(const Tensor<T>& x, F f, DF df) {
-  Tensor<T> out = new_output<T>(x.shape());
+  Tensor<T> out = new_output_overwritten<T>(x.shape());  // every element written below
   const T* xv = x.data();
   T* ov = out.data();
   const int64_t n = x.numel();

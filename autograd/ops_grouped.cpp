@@ -1,6 +1,7 @@
 #include "autograd/ops_grouped.hpp"
 
 #include "autograd/grouped_kernel.hpp"
+#include "autograd/grouped_planes_kernel.hpp"
 
 #include <string>
 
@@ -80,18 +81,24 @@ void kernel_backward(const GroupPlan& p, int64_t G, const std::complex<R>* px, c
   const int64_t N = p.offset[G];
 #pragma omp parallel if (N * in * out > kParallelMin)
   {
-    grouped_kernel::Buffer<R> a, s;
+    grouped_kernel::Buffer<R> a, s, xr, xi, nxi;
 #pragma omp for schedule(dynamic, 16)
     for (int64_t g = 0; g < G; ++g) {
       const int64_t b = p.offset[g], n = p.offset[g + 1] - b;
       if (n == 0) continue;
       const std::complex<R>* gy = pgy + b * out;
       if (dx) {
-        const grouped_kernel::CView<R> next = g + 1 < G ? weight(g + 1) : weight(g);
-        grouped_kernel::backward_x<R>(gy, weight(g), dx + b * in, n, in, out, a, s, g + 1 < G ? &next : nullptr);
+        const grouped_kernel::CView<R> w = weight(g), next = g + 1 < G ? weight(g + 1) : w;
+        if (w.es == 1)
+          grouped_planes_kernel::backward_x<R>(gy, w, dx + b * in, n, in, out);
+        else
+          grouped_kernel::backward_x<R>(gy, w, dx + b * in, n, in, out, a, s, g + 1 < G ? &next : nullptr);
       }
       const grouped_kernel::View<R> dw = dweight(g);
-      if (dw.re) grouped_kernel::backward_w<R>(gy, px + b * in, dw, n, in, out, a, s);
+      if (dw.re && dw.es == 1)
+        grouped_planes_kernel::backward_w<R>(gy, px + b * in, dw, n, in, out, xr, xi, nxi);
+      else if (dw.re)
+        grouped_kernel::backward_w<R>(gy, px + b * in, dw, n, in, out, a, s);
       const grouped_kernel::View<R> db = dbias(g);
       if (db.re)
         for (int64_t k = 0; k < n; ++k)

@@ -68,7 +68,7 @@ template <class T> Tensor<T> index_select_rows(const Tensor<T>& x, const Index& 
   check_2d("index_select_rows", x.shape());
   const int64_t R = x.rows(), C = x.cols(), N = static_cast<int64_t>(index.size());
   check_index("index_select_rows", index, R, x.shape());
-  auto out = new_output<T>({N, C});
+  auto out = new_output_overwritten<T>({N, C});
   const T* s = x.data();
   T* o = out.data();
 #pragma omp parallel for if (N * C > kParallelMin)

@@ -102,6 +102,22 @@ void backward_from(const std::shared_ptr<NodeBase>& root, bool retain_graph) {
   }
 }
 
+template <class T> void fill(Storage<T>& v, int64_t n, T x) {
+  if (n < (int64_t(1) << 20)) {
+    v.assign(static_cast<size_t>(n), x);
+    return;
+  }
+  v.clear();
+  v.resize(static_cast<size_t>(n));
+  T* p = v.data();
+#pragma omp parallel for schedule(static)
+  for (int64_t i = 0; i < n; ++i) p[i] = x;
+}
+template void fill(Storage<float>&, int64_t, float);
+template void fill(Storage<double>&, int64_t, double);
+template void fill(Storage<std::complex<float>>&, int64_t, std::complex<float>);
+template void fill(Storage<std::complex<double>>&, int64_t, std::complex<double>);
+
 // ---- Tensor -----------------------------------------------------------------------------------
 template <class T> Tensor<T> Tensor<T>::zeros(const Shape& shape, bool requires_grad) {
   return full(shape, T(0), requires_grad);
@@ -110,12 +126,17 @@ template <class T> Tensor<T> Tensor<T>::zeros(const Shape& shape, bool requires_
 template <class T> Tensor<T> Tensor<T>::full(const Shape& shape, T v, bool requires_grad) {
   auto n = std::make_shared<Node<T>>();
   n->shape = shape;
-  n->value.assign(static_cast<size_t>(numel_of(shape)), v);
+  fill(n->value, numel_of(shape), v);
   n->requires_grad = requires_grad;
   return Tensor<T>(std::move(n));
 }
 
-template <class T> Tensor<T> Tensor<T>::from(const Shape& shape, std::vector<T> values, bool requires_grad) {
+template <class T>
+Tensor<T> Tensor<T>::from(const Shape& shape, const std::vector<T>& values, bool requires_grad) {
+  return from(shape, Storage<T>(values.begin(), values.end()), requires_grad);
+}
+
+template <class T> Tensor<T> Tensor<T>::from(const Shape& shape, Storage<T> values, bool requires_grad) {
   if (static_cast<int64_t>(values.size()) != numel_of(shape))
     throw Error("Tensor::from: " + std::to_string(values.size()) + " values for shape " + shape_str(shape));
   auto n = std::make_shared<Node<T>>();

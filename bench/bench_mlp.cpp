@@ -101,6 +101,28 @@ void BM_GroupedLinearComplex(benchmark::State& state) {
   state.counters["GB/s"] = benchmark::Counter(grouped_min_bytes() * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
 }
 
+// The same on the layout GDSR's field uses: weights and bias read in place from two real
+// planes (the hyper-network's output, grouped_linear_planes), rows sorted by group.
+void BM_GroupedLinearPlanes(benchmark::State& state) {
+  using C = std::complex<float>;
+  const int64_t P = kF * kF + kF;  // weights, then bias
+  auto x = rand_tensor<C>({kRows, kF}, 6, 1.0, true);
+  auto re = rand_tensor<float>({kGroups, P}, 7, 0.1, true), im = rand_tensor<float>({kGroups, P}, 8, 0.1, true);
+  ag::Index group(kRows);
+  std::mt19937 rng(9);
+  for (auto& g : group) g = std::uniform_int_distribution<int64_t>(0, kGroups - 1)(rng);
+  std::sort(group.begin(), group.end());
+  for (auto _ : state) {
+    for (auto* t : {&re, &im}) t->zero_grad();
+    x.zero_grad();
+    auto y = ag::grouped_linear_planes(x, re, im, 0, kF * kF, group, kF);
+    ag::sum(ag::real(y)).backward();
+    benchmark::DoNotOptimize(re.grad().data());
+  }
+  state.counters["GFLOP/s"] = benchmark::Counter(grouped_flops() * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["GB/s"] = benchmark::Counter(grouped_min_bytes() * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+}
+
 // The memory yardstick of the grouped op: one pass that reads a weight-sized complex block
 // and writes another of the same size, twice over (the op's least traffic is three weight
 // blocks: W read in forward and again for dX, dW written). GB/s counted like the op's.
@@ -147,6 +169,7 @@ BENCHMARK(BM_GroupedLinearComplex)
     ->Arg(1)
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime();
+BENCHMARK(BM_GroupedLinearPlanes)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 BENCHMARK(BM_EigenGemmComplexSameFlops)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 BENCHMARK(BM_StreamWeightBlocks)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 

@@ -91,7 +91,7 @@ Inputs scaled(std::vector<Tensord> base, std::vector<int> deg = {}) {
     for (size_t i = 0; i < base.size(); ++i) {
       const int d = i < deg.size() ? deg[i] : 1;
       const double k = d == 0 ? 1.0 : (d == 1 ? s : s * s);
-      std::vector<double> v = base[i].values();
+      std::vector<double> v = ag::to_vector(base[i].values());
       for (double& x : v) x *= k;
       out.push_back(Tensord::from(base[i].shape(), v));
     }
@@ -599,7 +599,7 @@ std::vector<OpRows> table() {
   auto planes = [u43, v43, pre, pim](double s) {
     std::vector<Tensord> in = scaled({u43, v43})(s);
     for (const Tensord& p : {pre, pim}) {
-      std::vector<double> v = p.values();
+      std::vector<double> v = ag::to_vector(p.values());
       for (size_t k = 0; k < v.size(); ++k) v[k] *= (k % 10 == 7 || k % 10 == 8) ? s * s : s;
       in.push_back(Tensord::from(p.shape(), v));
     }

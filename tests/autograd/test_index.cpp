@@ -101,7 +101,8 @@ std::vector<std::vector<double>> scatter_results(int threads) {
   const Tensord c = randn({N, C}, 46);
   (ag::sum(ag::mul(s, s)) + ag::sum(m) + ag::sum(ag::mul(ag::index_select_rows(s, idx) + gsel + ip, c))).backward();
   omp_set_num_threads(omp_get_num_procs());
-  return {s.values(), m.values(), x.grad(), v.grad(), w.grad()};
+  return {ag::to_vector(s.values()), ag::to_vector(m.values()), ag::to_vector(x.grad()), ag::to_vector(v.grad()),
+          ag::to_vector(w.grad())};
 }
 }  // namespace
 

@@ -87,7 +87,7 @@ TEST_CASE("linear_leaky_relu: gradient, and equal to leaky_relu(linear) bit for 
             bl = bf.detach().set_requires_grad(true);
     const Tensorf y = fused ? ag::linear_leaky_relu(xl, wl, bl, 0.02f) : ag::leaky_relu(ag::linear(xl, wl, bl), 0.02f);
     ag::sum(ag::mul(y, cf)).backward();
-    return std::vector<std::vector<float>>{y.values(), xl.grad(), wl.grad(), bl.grad()};
+    return std::vector<ag::Storage<float>>{y.values(), xl.grad(), wl.grad(), bl.grad()};
   };
   const auto f = run(true), u = run(false);
   for (size_t k = 0; k < f.size(); ++k) CHECK(f[k] == u[k]);

@@ -22,7 +22,7 @@ struct Net : nn::Module<double> {
   }
 };
 
-std::pair<double, double> min_max(const std::vector<double>& v) {
+std::pair<double, double> min_max(const ag::Storage<double>& v) {
   return {*std::min_element(v.begin(), v.end()), *std::max_element(v.begin(), v.end())};
 }
 }  // namespace

@@ -67,7 +67,7 @@ inline double max_abs(const Tensord& t) {
   return m;
 }
 
-inline bool all_finite(const std::vector<double>& v) {
+inline bool all_finite(const ag::Storage<double>& v) {
   for (double x : v)
     if (!std::isfinite(x)) return false;
   return true;

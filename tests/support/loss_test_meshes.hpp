@@ -1,6 +1,7 @@
 // Small garments for the loss / patch / collision tests (header-only, test helpers).
 #pragma once
 
+#include "autograd/tensor.hpp"
 #include "gdsr/geometry/mesh.hpp"
 #include "tests/support/grid_garment.hpp"
 
@@ -69,7 +70,7 @@ inline std::vector<DegenerateCase> degenerate_cases(const gdsr::Points3& P, int 
 }
 
 // |dL/dx_v| per vertex of a flat [V x 3] gradient.
-inline std::vector<double> vertex_norms(const std::vector<double>& grad) {
+inline std::vector<double> vertex_norms(const ag::Storage<double>& grad) {
   std::vector<double> n(grad.size() / 3);
   for (size_t i = 0; i < n.size(); ++i)
     n[i] = std::sqrt(grad[3 * i] * grad[3 * i] + grad[3 * i + 1] * grad[3 * i + 1] + grad[3 * i + 2] * grad[3 * i + 2]);

@@ -101,8 +101,8 @@ inline std::unique_ptr<gdsr::GDSR<double>> model_in_units(const gdsr::GDSR<doubl
   const auto src = model.named_parameters();
   auto dst = out->named_parameters();
   for (size_t i = 0; i < src.size(); ++i) {
-    const std::vector<double>& v = src[i].second.values();
-    std::vector<double>& d = dst[i].second.values();
+    const ag::Storage<double>& v = src[i].second.values();
+    ag::Storage<double>& d = dst[i].second.values();
     const int64_t cols = dst[i].second.cols();
     for (size_t j = 0; j < v.size(); ++j)
       d[j] = v[j] * std::pow(s, unit_power(src[i].first, static_cast<int64_t>(j) % cols));

@@ -16,7 +16,7 @@ using namespace gdsr;
 
 namespace {
 
-bool finite(const std::vector<double>& v) {
+bool finite(const ag::Storage<double>& v) {
   for (double x : v)
     if (!std::isfinite(x)) return false;
   return true;

@@ -73,7 +73,7 @@ TEST_CASE("trainer: two frames per step equal the gradient of their averaged los
   // alone barely reaches); every other entry must agree to 1e-3 lr.
   std::vector<std::vector<float>> grads;
   for (const auto& [name, p] : model.named_parameters())
-    grads.push_back(p.has_grad() ? p.grad() : std::vector<float>(p.numel(), 0.f));
+    grads.push_back(p.has_grad() ? ag::to_vector(p.grad()) : std::vector<float>(p.numel(), 0.f));
   adam.step();
   gdsr::GDSR<float> trained(o.model);
   nn::load_checkpoint<float>(o.checkpoint, trained, nullptr);

@@ -14,7 +14,7 @@ using gdsr_test::grid_garment;
 
 namespace {
 
-bool all_finite(const std::vector<double>& v) {
+bool all_finite(const ag::Storage<double>& v) {
   for (double x : v)
     if (!std::isfinite(x)) return false;
   return true;
