@@ -1,20 +1,20 @@
-// Internal to ops_grouped.cpp: SIMD kernels of the complex grouped linear map's BACKWARD
-// pass for weights stored as two real planes (the hyper-network's output, GDSR's field: one
-// 64 x 64 complex matrix per LR triangle, applied to the ~4-7 HR samples inside it).
+// Internal to ops_grouped.cpp: SIMD kernels of the complex grouped linear map for weights
+// stored as two real planes (the hyper-network's output, GDSR's field: one 64 x 64 complex
+// matrix per LR triangle, applied to the ~4-7 HR samples inside it).
 //
 // grouped_kernel.hpp puts a group's ROWS in the SIMD lanes, which leaves lanes empty when a
 // group has fewer rows than a packet holds (8 complex rows with AVX-512 floats; the field
-// has ~4.3 per triangle). These kernels put the weights' contiguous index (the input i of
-// W[o][i], row-major out x in) in the lanes instead, so that every lane works whatever the
-// row count:
-//   backward_x  dx[r][i] += sum_o g[r][o] conj(W[o][i])   lanes over i, g broadcast;
-//   backward_w  dW[o][i] += sum_r g[r][o] conj(x[r][i])   lanes over i, g broadcast.
-// (The forward y[r][o] = sum_i W[o][i] x[r][i] has no lane-wise form in this layout: a
-// dot-product kernel with a transposing reduction measured slower than grouped_kernel's
-// forward, which ops_grouped.cpp keeps using: 9.5 vs 11.8 ms at 6.5 rows per group, equal
-// at 4.3, one thread, bench_mlp's sizes.)
-// Measured the same way, at 6.5 / 4.3 rows per group: backward_x 7.4 / 4.5 ms against
-// 10.0 / 8.5 ms for grouped_kernel's, backward_w 7.2 / 5.7 against 9.2 / 7.9 ms.
+// has ~4.3 per triangle). These kernels put a matrix's contiguous index in the lanes and
+// broadcast the rows' values, so that every lane works whatever the row count:
+//   backward_x  dx[r][i] += sum_o g[r][o] conj(W[o][i])   lanes over i (W as stored);
+//   backward_w  dW[o][i] += sum_r g[r][o] conj(x[r][i])   lanes over i;
+//   forward     y[r][o]  += sum_i x[r][i] W^T[i][o]       lanes over o, W transposed into
+//               scratch first (L x L register tiles).
+// Each group's weights are used by a handful of rows, so the op streams them from memory
+// (~6 flops per byte); every kernel prefetches the next group's weights (or dW) while it
+// works on the current one, spread over its steps.
+// Measured against grouped_kernel's on bench_mlp's sizes (one thread, 6.5 rows per group):
+// forward 6.4 vs 9.0-9.6 ms, backward_x 5.5 vs 10.1 ms, backward_w 6.9 vs 9.2 ms.
 // Complex products in planes: (a + ib)(c + id) = (ac - bd) + i(ad + bc), two FMAs per plane.
 // Results equal the plain complex sums up to floating-point rounding order.
 #pragma once
@@ -68,96 +68,169 @@ template <> inline void add_interleaved<float>(std::complex<float>* d, const Pac
 }
 #endif
 
-// dx[n x in] += g[n x out] conj(W) for one group: RB rows at a time, inputs in blocks of IP
-// packets, accumulated in registers over all outputs. IN, OUT: the sizes as compile-time
-// constants (0: in_rt, out_rt), for constant address offsets between rows.
-template <class R, int RB, int IP, int IN, int OUT>
-inline void backward_x_block(const std::complex<R>* g, const CView<R>& W, std::complex<R>* dx, int64_t in_rt,
-                             int64_t out_rt, int64_t i0) {
+// dst[n x J] += a[n x K] op(M) for one group, M [K x J] row-major planes, op = conj
+// (Conj) or identity: the rows of M in the lanes, a broadcast. RB rows at a time, columns
+// in blocks of JP packets, accumulated in registers over all K. KD, JD: K and J as
+// compile-time constants (0: k_rt, j_rt), for constant address offsets between rows.
+template <class R, bool Conj, int RB, int JP, int KD, int JD>
+inline void lanes_block(const std::complex<R>* a, const CView<R>& M, std::complex<R>* dst, int64_t k_rt, int64_t j_rt,
+                        int64_t j0, const char* pf_re = nullptr, const char* pf_im = nullptr, int pf_per_k = 0) {
   using namespace Eigen::internal;
   using P = Packet<R>;
   constexpr int L = kLanes<R>;
-  const int64_t in = IN > 0 ? IN : in_rt, out = OUT > 0 ? OUT : out_rt;
-  P re[RB][IP], im[RB][IP];
+  const int64_t K = KD > 0 ? KD : k_rt, J = JD > 0 ? JD : j_rt;
+  P re[RB][JP], im[RB][JP];
   for (int r = 0; r < RB; ++r)
-    for (int p = 0; p < IP; ++p) re[r][p] = im[r][p] = pset1<P>(R(0));
-  const R* gv = reinterpret_cast<const R*>(g);
-  const R* wr_row = W.re + i0;
-  const R* wi_row = W.im + i0;
-  for (int64_t o = 0; o < out; ++o, wr_row += in, wi_row += in, gv += 2) {
-    P wr[IP], wi[IP], nwi[IP];
-    for (int p = 0; p < IP; ++p) {
-      wr[p] = ploadu<P>(wr_row + p * L), wi[p] = ploadu<P>(wi_row + p * L);
-      nwi[p] = pnegate(wi[p]);
+    for (int p = 0; p < JP; ++p) re[r][p] = im[r][p] = pset1<P>(R(0));
+  const R* av = reinterpret_cast<const R*>(a);
+  const R* mr_row = M.re + j0;
+  const R* mi_row = M.im + j0;
+  for (int64_t k = 0; k < K; ++k, mr_row += J, mi_row += J, av += 2) {
+    for (int l = 0; l < pf_per_k; ++l)
+      __builtin_prefetch(pf_re + 64 * (k * pf_per_k + l)), __builtin_prefetch(pf_im + 64 * (k * pf_per_k + l));
+    P mr[JP], mi[JP], nmi[JP];
+    for (int p = 0; p < JP; ++p) {
+      mr[p] = ploadu<P>(mr_row + p * L), mi[p] = ploadu<P>(mi_row + p * L);
+      nmi[p] = pnegate(mi[p]);
     }
     for (int r = 0; r < RB; ++r) {
-      const P ga = pset1<P>(gv[2 * r * out]), gb = pset1<P>(gv[2 * r * out + 1]);
-      // conj(w) g = (wr ga + wi gb) + i (wr gb - wi ga)
-      for (int p = 0; p < IP; ++p) {
-        re[r][p] = pmadd(ga, wr[p], pmadd(gb, wi[p], re[r][p]));
-        im[r][p] = pmadd(gb, wr[p], pmadd(ga, nwi[p], im[r][p]));
+      const P ga = pset1<P>(av[2 * r * K]), gb = pset1<P>(av[2 * r * K + 1]);
+      // conj(m) a = (mr ga + mi gb) + i (mr gb - mi ga);  m a = (mr ga - mi gb) + i (mr gb + mi ga)
+      for (int p = 0; p < JP; ++p) {
+        re[r][p] = pmadd(ga, mr[p], pmadd(gb, Conj ? mi[p] : nmi[p], re[r][p]));
+        im[r][p] = pmadd(gb, mr[p], pmadd(ga, Conj ? nmi[p] : mi[p], im[r][p]));
       }
     }
   }
   for (int r = 0; r < RB; ++r)
-    for (int p = 0; p < IP; ++p) add_interleaved<R>(dx + r * in + i0 + p * L, re[r][p], im[r][p]);
+    for (int p = 0; p < JP; ++p) add_interleaved<R>(dst + r * J + j0 + p * L, re[r][p], im[r][p]);
 }
 
-// Few rows: wider input blocks, so that enough independent accumulators hide the FMA latency.
-template <class R, int RB, int IN, int OUT>
-void backward_x_rows(const std::complex<R>* g, const CView<R>& W, std::complex<R>* dx, int64_t in, int64_t out) {
-  constexpr int L = kLanes<R>, IP = RB <= 3 ? 4 : 2;
-  int64_t i = 0;
-  for (; i + IP * L <= in; i += IP * L) backward_x_block<R, RB, IP, IN, OUT>(g, W, dx, in, out, i);
-  for (; i + L <= in; i += L) backward_x_block<R, RB, 1, IN, OUT>(g, W, dx, in, out, i);
+// Few rows: wider column blocks, so that enough independent accumulators hide the FMA latency.
+template <class R, bool Conj, int RB, int KD, int JD>
+void lanes_rows(const std::complex<R>* a, const CView<R>& M, std::complex<R>* dst, int64_t K, int64_t J,
+                const CView<R>* next = nullptr, int64_t* pf_line = nullptr, int64_t pf_lines = 0, int pf_per_k = 0) {
+  constexpr int L = kLanes<R>, JP = RB <= 3 ? 4 : 2;
+  int64_t j = 0;
+  for (; j + JP * L <= J; j += JP * L) {
+    const char* pr = nullptr;
+    const char* pi = nullptr;
+    int per_k = 0;
+    if (next && *pf_line < pf_lines) {
+      pr = reinterpret_cast<const char*>(next->re) + 64 * *pf_line;
+      pi = reinterpret_cast<const char*>(next->im) + 64 * *pf_line;
+      per_k = static_cast<int>(std::min<int64_t>(pf_per_k, (pf_lines - *pf_line) / K));
+      *pf_line += per_k * K;
+    }
+    lanes_block<R, Conj, RB, JP, KD, JD>(a, M, dst, K, J, j, pr, pi, per_k);
+  }
+  for (; j + L <= J; j += L) lanes_block<R, Conj, RB, 1, KD, JD>(a, M, dst, K, J, j);
 }
 
-template <class R, int IN, int OUT>
-void backward_x_impl(const std::complex<R>* g, const CView<R>& W, std::complex<R>* dx, int64_t n, int64_t in,
-                     int64_t out) {
+template <class R, bool Conj, int KD, int JD>
+void lanes_product_impl(const std::complex<R>* a, const CView<R>& M, std::complex<R>* dst, int64_t n, int64_t K,
+                        int64_t J, const CView<R>* next = nullptr) {
   constexpr int L = kLanes<R>, RB = 6;
+  // The next group's matrix (`next`, or null) is prefetched meanwhile, a few cache lines of
+  // each plane per step of k, spread over all column blocks of this group.
   const int64_t passes = (n + RB - 1) / RB, per_pass = (n + passes - 1) / passes;  // 7 rows: 4 + 3
+  int64_t blocks = 0;
+  for (int64_t r0 = 0; r0 < n; r0 += per_pass) blocks += J / ((std::min<int64_t>(per_pass, n - r0) <= 3 ? 4 : 2) * L);
+  int64_t pf_line = 0;
+  const int64_t pf_lines = (K * J * int64_t(sizeof(R)) + 63) / 64;
+  const int pf_per_k = blocks > 0 ? static_cast<int>((pf_lines + blocks * K - 1) / (blocks * K)) : 0;
   for (int64_t r0 = 0; r0 < n; r0 += per_pass) {
     const int64_t rows = std::min<int64_t>(per_pass, n - r0);
-    const std::complex<R>* gr = g + r0 * out;
-    std::complex<R>* dr = dx + r0 * in;
+    const std::complex<R>* ar = a + r0 * K;
+    std::complex<R>* dr = dst + r0 * J;
     switch (rows) {  // the row count as a constant: the accumulators stay in registers
-      case 1: backward_x_rows<R, 1, IN, OUT>(gr, W, dr, in, out); break;
-      case 2: backward_x_rows<R, 2, IN, OUT>(gr, W, dr, in, out); break;
-      case 3: backward_x_rows<R, 3, IN, OUT>(gr, W, dr, in, out); break;
-      case 4: backward_x_rows<R, 4, IN, OUT>(gr, W, dr, in, out); break;
-      case 5: backward_x_rows<R, 5, IN, OUT>(gr, W, dr, in, out); break;
-      default: backward_x_rows<R, RB, IN, OUT>(gr, W, dr, in, out); break;
+      case 1: lanes_rows<R, Conj, 1, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k); break;
+      case 2: lanes_rows<R, Conj, 2, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k); break;
+      case 3: lanes_rows<R, Conj, 3, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k); break;
+      case 4: lanes_rows<R, Conj, 4, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k); break;
+      case 5: lanes_rows<R, Conj, 5, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k); break;
+      default: lanes_rows<R, Conj, RB, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k); break;
     }
-    for (int64_t k = in / L * L; k < in; ++k)  // inputs beyond the whole packets
+    for (int64_t j = J / L * L; j < J; ++j)  // columns beyond the whole packets
       for (int64_t r = 0; r < rows; ++r) {
         std::complex<R> acc(0);
-        for (int64_t o = 0; o < out; ++o)
-          acc += gr[r * out + o] * std::complex<R>(W.re[o * in + k], -W.im[o * in + k]);
-        dr[r * in + k] += acc;
+        for (int64_t k = 0; k < K; ++k) {
+          const std::complex<R> m(M.re[k * J + j], M.im[k * J + j]);
+          acc += ar[r * K + k] * (Conj ? std::conj(m) : m);
+        }
+        dr[r * J + j] += acc;
       }
   }
 }
 
-template <class R> void backward_x(const std::complex<R>* g, const CView<R>& W, std::complex<R>* dx, int64_t n,
-                                   int64_t in, int64_t out) {
-  if (in == 64 && out == 64)  // the field's hidden layers
-    backward_x_impl<R, 64, 64>(g, W, dx, n, in, out);
+template <class R, bool Conj>
+void lanes_product(const std::complex<R>* a, const CView<R>& M, std::complex<R>* dst, int64_t n, int64_t K, int64_t J,
+                   const CView<R>* next = nullptr) {
+  if (K == 64 && J == 64)  // the field's hidden layers
+    lanes_product_impl<R, Conj, 64, 64>(a, M, dst, n, K, J, next);
   else
-    backward_x_impl<R, 0, 0>(g, W, dx, n, in, out);
+    lanes_product_impl<R, Conj, 0, 0>(a, M, dst, n, K, J, next);
+}
+
+// dx[n x in] += g[n x out] conj(W) for one group.
+template <class R> void backward_x(const std::complex<R>* g, const CView<R>& W, std::complex<R>* dx, int64_t n,
+                                   int64_t in, int64_t out, const CView<R>* next = nullptr) {
+  lanes_product<R, true>(g, W, dx, n, out, in, next);
+}
+
+// The planes of W [out x in] transposed into t_re, t_im [in x out]: L x L tiles through
+// registers, the ragged edges element by element.
+template <class R> void transpose_planes(const CView<R>& W, int64_t out, int64_t in, Buffer<R>& t_re, Buffer<R>& t_im) {
+  using namespace Eigen::internal;
+  using P = Packet<R>;
+  constexpr int L = kLanes<R>;
+  t_re.resize(static_cast<size_t>(in * out));
+  t_im.resize(t_re.size());
+  const int64_t ot = out / L * L, it = in / L * L;
+  for (int plane = 0; plane < 2; ++plane) {
+    const R* src = plane == 0 ? W.re : W.im;
+    R* dst = plane == 0 ? t_re.data() : t_im.data();
+    for (int64_t o = 0; o < ot; o += L)
+      for (int64_t i = 0; i < it; i += L) {
+        PacketBlock<P, L> b;
+        for (int l = 0; l < L; ++l) b.packet[l] = ploadu<P>(src + (o + l) * in + i);
+        ptranspose(b);
+        for (int l = 0; l < L; ++l) pstoreu(dst + (i + l) * out + o, b.packet[l]);
+      }
+    for (int64_t o = 0; o < out; ++o)
+      for (int64_t i = o < ot ? it : 0; i < in; ++i) dst[i * out + o] = src[o * in + i];
+  }
+}
+
+// y[n x out] += x W^T for one group (y holds the bias or zeros on entry): W transposed into
+// scratch once, then the outputs in the lanes.
+template <class R> void forward(const std::complex<R>* x, const CView<R>& W, std::complex<R>* y, int64_t n, int64_t in,
+                                int64_t out, Buffer<R>& t_re, Buffer<R>& t_im, const CView<R>* next = nullptr) {
+  transpose_planes(W, out, in, t_re, t_im);
+  lanes_product<R, false>(x, CView<R>{t_re.data(), t_im.data(), 1}, y, n, in, out, next);
 }
 
 // dW[out x in] += g^T conj(x) for one group of n rows, dW as planes: O outputs x Q packets
-// of inputs per block, each dW element loaded and stored once.
+// of inputs per block, each dW element loaded and stored once. `next` (or null): the next
+// group's dW, prefetched for writing meanwhile, a share per block.
 template <class R> void backward_w(const std::complex<R>* g, const std::complex<R>* x, const View<R>& dW, int64_t n,
-                                   int64_t in, int64_t out, Buffer<R>& xr, Buffer<R>& xi, Buffer<R>& nxi) {
+                                   int64_t in, int64_t out, Buffer<R>& xr, Buffer<R>& xi, Buffer<R>& nxi,
+                                   const View<R>* next = nullptr) {
   using namespace Eigen::internal;
   using P = Packet<R>;
   constexpr int L = kLanes<R>, O = 2, Q = 4;
   split_planes(x, n, in, xr, xi, nxi);
   const R* gv = reinterpret_cast<const R*>(g);
+  const int64_t pf_lines = (in * out * int64_t(sizeof(R)) + 63) / 64;
+  const int64_t pf_per_block = (pf_lines + (out / O) - 1) / std::max<int64_t>(1, out / O);
+  int64_t pf_line = 0;
   auto block = [&](auto o_count, auto q_count, int64_t o, int64_t i) {
     constexpr int OC = decltype(o_count)::value, QC = decltype(q_count)::value;
+    if (next && i == 0)
+      for (int64_t l = 0; l < pf_per_block && pf_line < pf_lines; ++l, ++pf_line) {
+        __builtin_prefetch(reinterpret_cast<const char*>(next->re) + 64 * pf_line, 1);
+        __builtin_prefetch(reinterpret_cast<const char*>(next->im) + 64 * pf_line, 1);
+      }
     P re[OC][QC], im[OC][QC];
     for (int j = 0; j < OC; ++j)
       for (int q = 0; q < QC; ++q)

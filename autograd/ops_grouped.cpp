@@ -58,17 +58,24 @@ template <class R, class WF, class BF> void kernel_forward(const GroupPlan& p, i
 #pragma omp parallel if (N * in * out > kParallelMin)
   {
     grouped_kernel::Buffer<R> a, s;
+    std::vector<std::complex<R>> bias_row;
 #pragma omp for schedule(dynamic, 16)
     for (int64_t g = 0; g < G; ++g) {
       const int64_t b = p.offset[g], n = p.offset[g + 1] - b;
       if (n == 0) continue;
       std::complex<R>* yg = py + b * out;
       const grouped_kernel::CView<R> bv = bias(g);
-      if (bv.re)
-        for (int64_t k = 0; k < n; ++k)
-          for (int64_t o = 0; o < out; ++o) yg[k * out + o] = {bv.re[o * bv.es], bv.im[o * bv.es]};
+      if (bv.re) {  // the bias row once, then copied to each row
+        bias_row.resize(static_cast<size_t>(out));
+        for (int64_t o = 0; o < out; ++o) bias_row[o] = {bv.re[o * bv.es], bv.im[o * bv.es]};
+        for (int64_t k = 0; k < n; ++k) std::copy(bias_row.begin(), bias_row.end(), yg + k * out);
+      }
       const grouped_kernel::CView<R> next = g + 1 < G ? weight(g + 1) : weight(g);
-      grouped_kernel::forward<R>(px + b * in, weight(g), yg, n, in, out, a, s, g + 1 < G ? &next : nullptr);
+      const grouped_kernel::CView<R> w = weight(g);
+      if (w.es == 1)  // planes: transposed into a and s, the outputs in the lanes
+        grouped_planes_kernel::forward<R>(px + b * in, w, yg, n, in, out, a, s, g + 1 < G ? &next : nullptr);
+      else
+        grouped_kernel::forward<R>(px + b * in, w, yg, n, in, out, a, s, g + 1 < G ? &next : nullptr);
     }
   }
 }
@@ -90,13 +97,16 @@ void kernel_backward(const GroupPlan& p, int64_t G, const std::complex<R>* px, c
       if (dx) {
         const grouped_kernel::CView<R> w = weight(g), next = g + 1 < G ? weight(g + 1) : w;
         if (w.es == 1)
-          grouped_planes_kernel::backward_x<R>(gy, w, dx + b * in, n, in, out);
+          grouped_planes_kernel::backward_x<R>(gy, w, dx + b * in, n, in, out, g + 1 < G ? &next : nullptr);
         else
           grouped_kernel::backward_x<R>(gy, w, dx + b * in, n, in, out, a, s, g + 1 < G ? &next : nullptr);
       }
       const grouped_kernel::View<R> dw = dweight(g);
-      if (dw.re && dw.es == 1)
-        grouped_planes_kernel::backward_w<R>(gy, px + b * in, dw, n, in, out, xr, xi, nxi);
+      if (dw.re && dw.es == 1) {
+        const grouped_kernel::View<R> dw_next = g + 1 < G ? dweight(g + 1) : dw;
+        grouped_planes_kernel::backward_w<R>(gy, px + b * in, dw, n, in, out, xr, xi, nxi,
+                                             g + 1 < G ? &dw_next : nullptr);
+      }
       else if (dw.re)
         grouped_kernel::backward_w<R>(gy, px + b * in, dw, n, in, out, a, s);
       const grouped_kernel::View<R> db = dbias(g);

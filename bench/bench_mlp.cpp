@@ -103,7 +103,11 @@ void BM_GroupedLinearComplex(benchmark::State& state) {
 
 // The same on the layout GDSR's field uses: weights and bias read in place from two real
 // planes (the hyper-network's output, grouped_linear_planes), rows sorted by group.
+// fresh_grads:1 zeroes the gradients every iteration (allocating and filling 77 MB of weight
+// gradients, as the field's planes get in every training step); fresh_grads:0 adds into the
+// existing ones (the op alone, like the dense GEMM yardstick, which writes its dW afresh).
 void BM_GroupedLinearPlanes(benchmark::State& state) {
+  const bool fresh = state.range(0) != 0;
   using C = std::complex<float>;
   const int64_t P = kF * kF + kF;  // weights, then bias
   auto x = rand_tensor<C>({kRows, kF}, 6, 1.0, true);
@@ -113,8 +117,8 @@ void BM_GroupedLinearPlanes(benchmark::State& state) {
   for (auto& g : group) g = std::uniform_int_distribution<int64_t>(0, kGroups - 1)(rng);
   std::sort(group.begin(), group.end());
   for (auto _ : state) {
-    for (auto* t : {&re, &im}) t->zero_grad();
-    x.zero_grad();
+    if (fresh)
+      for (auto* t : {&re, &im}) t->zero_grad();
     auto y = ag::grouped_linear_planes(x, re, im, 0, kF * kF, group, kF);
     ag::sum(ag::real(y)).backward();
     benchmark::DoNotOptimize(re.grad().data());
@@ -169,7 +173,12 @@ BENCHMARK(BM_GroupedLinearComplex)
     ->Arg(1)
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime();
-BENCHMARK(BM_GroupedLinearPlanes)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+BENCHMARK(BM_GroupedLinearPlanes)
+    ->ArgName("fresh_grads")
+    ->Arg(1)
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime();
 BENCHMARK(BM_EigenGemmComplexSameFlops)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 BENCHMARK(BM_StreamWeightBlocks)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 
