@@ -10,6 +10,8 @@
 //   [re | im](w x) = wr * [xr | xi] + wi * [-xi | xr].
 // The packet type is Eigen's for the build's instruction set (SSE, AVX, AVX-512).
 // Results equal the plain complex sums up to floating-point rounding order.
+// Used for weights stored interleaved (grouped_linear on complex tensors); weights stored as
+// two real planes (the model's field) go through grouped_planes_kernel.hpp instead.
 #pragma once
 
 #include <Eigen/Core>

@@ -38,8 +38,8 @@ using grouped_kernel::Packet;
 using grouped_kernel::View;
 
 // x [n x in] interleaved -> planes xr, xi, and nxi = -xi (row stride in).
-template <class R> void split_planes(const std::complex<R>* x, int64_t n, int64_t in, Buffer<R>& xr, Buffer<R>& xi,
-                                     Buffer<R>& nxi) {
+template <class R>
+void split_planes(const std::complex<R>* x, int64_t n, int64_t in, Buffer<R>& xr, Buffer<R>& xi, Buffer<R>& nxi) {
   xr.resize(static_cast<size_t>(n * in));
   xi.resize(xr.size());
   nxi.resize(xr.size());
@@ -59,7 +59,8 @@ template <class R> inline void add_interleaved(std::complex<R>* d, const Packet<
   for (int l = 0; l < L; ++l) d[l] += std::complex<R>(tr[l], ti[l]);
 }
 #if defined(__AVX512F__)
-template <> inline void add_interleaved<float>(std::complex<float>* d, const Packet<float>& re, const Packet<float>& im) {
+template <>
+inline void add_interleaved<float>(std::complex<float>* d, const Packet<float>& re, const Packet<float>& im) {
   const __m512i lo = _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
   const __m512i hi = _mm512_setr_epi32(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
   float* p = reinterpret_cast<float*>(d);
@@ -127,9 +128,9 @@ void lanes_rows(const std::complex<R>* a, const CView<R>& M, std::complex<R>* ds
   for (; j + L <= J; j += L) lanes_block<R, Conj, RB, 1, KD, JD>(a, M, dst, K, J, j);
 }
 
-template <class R, bool Conj, int KD, int JD>
-void lanes_product_impl(const std::complex<R>* a, const CView<R>& M, std::complex<R>* dst, int64_t n, int64_t K,
-                        int64_t J, const CView<R>* next = nullptr) {
+template <class R, bool Conj, int KD, int JD> void lanes_product_impl(const std::complex<R>* a, const CView<R>& M,
+                                                                      std::complex<R>* dst, int64_t n, int64_t K,
+                                                                      int64_t J, const CView<R>* next = nullptr) {
   constexpr int L = kLanes<R>, RB = 6;
   // The next group's matrix (`next`, or null) is prefetched meanwhile, a few cache lines of
   // each plane per step of k, spread over all column blocks of this group.
@@ -144,12 +145,24 @@ void lanes_product_impl(const std::complex<R>* a, const CView<R>& M, std::comple
     const std::complex<R>* ar = a + r0 * K;
     std::complex<R>* dr = dst + r0 * J;
     switch (rows) {  // the row count as a constant: the accumulators stay in registers
-      case 1: lanes_rows<R, Conj, 1, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k); break;
-      case 2: lanes_rows<R, Conj, 2, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k); break;
-      case 3: lanes_rows<R, Conj, 3, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k); break;
-      case 4: lanes_rows<R, Conj, 4, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k); break;
-      case 5: lanes_rows<R, Conj, 5, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k); break;
-      default: lanes_rows<R, Conj, RB, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k); break;
+      case 1:
+        lanes_rows<R, Conj, 1, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k);
+        break;
+      case 2:
+        lanes_rows<R, Conj, 2, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k);
+        break;
+      case 3:
+        lanes_rows<R, Conj, 3, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k);
+        break;
+      case 4:
+        lanes_rows<R, Conj, 4, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k);
+        break;
+      case 5:
+        lanes_rows<R, Conj, 5, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k);
+        break;
+      default:
+        lanes_rows<R, Conj, RB, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k);
+        break;
     }
     for (int64_t j = J / L * L; j < J; ++j)  // columns beyond the whole packets
       for (int64_t r = 0; r < rows; ++r) {
@@ -163,9 +176,8 @@ void lanes_product_impl(const std::complex<R>* a, const CView<R>& M, std::comple
   }
 }
 
-template <class R, bool Conj>
-void lanes_product(const std::complex<R>* a, const CView<R>& M, std::complex<R>* dst, int64_t n, int64_t K, int64_t J,
-                   const CView<R>* next = nullptr) {
+template <class R, bool Conj> void lanes_product(const std::complex<R>* a, const CView<R>& M, std::complex<R>* dst,
+                                                 int64_t n, int64_t K, int64_t J, const CView<R>* next = nullptr) {
   if (K == 64 && J == 64)  // the field's hidden layers
     lanes_product_impl<R, Conj, 64, 64>(a, M, dst, n, K, J, next);
   else

@@ -106,8 +106,7 @@ void kernel_backward(const GroupPlan& p, int64_t G, const std::complex<R>* px, c
         const grouped_kernel::View<R> dw_next = g + 1 < G ? dweight(g + 1) : dw;
         grouped_planes_kernel::backward_w<R>(gy, px + b * in, dw, n, in, out, xr, xi, nxi,
                                              g + 1 < G ? &dw_next : nullptr);
-      }
-      else if (dw.re)
+      } else if (dw.re)
         grouped_kernel::backward_w<R>(gy, px + b * in, dw, n, in, out, a, s);
       const grouped_kernel::View<R> db = dbias(g);
       if (db.re)

@@ -131,8 +131,7 @@ template <class T> Tensor<T> Tensor<T>::full(const Shape& shape, T v, bool requi
   return Tensor<T>(std::move(n));
 }
 
-template <class T>
-Tensor<T> Tensor<T>::from(const Shape& shape, const std::vector<T>& values, bool requires_grad) {
+template <class T> Tensor<T> Tensor<T>::from(const Shape& shape, const std::vector<T>& values, bool requires_grad) {
   return from(shape, Storage<T>(values.begin(), values.end()), requires_grad);
 }
 

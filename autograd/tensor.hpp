@@ -14,10 +14,10 @@
 
 #include <Eigen/Core>
 #include <algorithm>
-#include <initializer_list>
 #include <complex>
 #include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -69,9 +69,7 @@ class NoGradGuard {
 // (default-init, not value-init), so that an op that writes every element of its output does
 // not first zero it in one serial pass (new_output_overwritten). assign() fills as usual.
 template <class T> struct DefaultInitAllocator : std::allocator<T> {
-  template <class U> struct rebind {
-    using other = DefaultInitAllocator<U>;
-  };
+  template <class U> struct rebind { using other = DefaultInitAllocator<U>; };
   DefaultInitAllocator() = default;
   template <class U> DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
   template <class U> void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) { ::new (p) U; }

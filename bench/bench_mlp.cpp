@@ -98,7 +98,8 @@ void BM_GroupedLinearComplex(benchmark::State& state) {
     benchmark::DoNotOptimize(w.grad().data());
   }
   state.counters["GFLOP/s"] = benchmark::Counter(grouped_flops() * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
-  state.counters["GB/s"] = benchmark::Counter(grouped_min_bytes() * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["GB/s"] =
+      benchmark::Counter(grouped_min_bytes() * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
 }
 
 // The same on the layout GDSR's field uses: weights and bias read in place from two real
@@ -124,7 +125,8 @@ void BM_GroupedLinearPlanes(benchmark::State& state) {
     benchmark::DoNotOptimize(re.grad().data());
   }
   state.counters["GFLOP/s"] = benchmark::Counter(grouped_flops() * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
-  state.counters["GB/s"] = benchmark::Counter(grouped_min_bytes() * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["GB/s"] =
+      benchmark::Counter(grouped_min_bytes() * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
 }
 
 // The memory yardstick of the grouped op: one pass that reads a weight-sized complex block
@@ -143,8 +145,8 @@ void BM_StreamWeightBlocks(benchmark::State& state) {
     }
     benchmark::DoNotOptimize(b.data());
   }
-  state.counters["GB/s"] = benchmark::Counter(4.0 * sizeof(C) * kGroups * kF * kF * 1e-9,
-                                              benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["GB/s"] =
+      benchmark::Counter(4.0 * sizeof(C) * kGroups * kF * kF * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
 }
 
 // One dense complex GEMM of the same total size (upper bound for the grouped op).

@@ -207,8 +207,10 @@ namespace {
 template <class R> double planes_vs_interleaved(int64_t in, int64_t out, const ag::Index& g, int64_t G) {
   using C = std::complex<R>;
   auto real_t = [](const Tensord& t) {
-    if constexpr (std::is_same_v<R, double>) return t;
-    else return to_float(t);
+    if constexpr (std::is_same_v<R, double>)
+      return t;
+    else
+      return to_float(t);
   };
   const int64_t N = static_cast<int64_t>(g.size()), wb = 1, bb = 1 + in * out, P = bb + out + 2;  // unaligned start
   const auto x0 = ag::complex_from(real_t(randn({N, in}, 61)), real_t(randn({N, in}, 62)));
@@ -227,7 +229,8 @@ template <class R> double planes_vs_interleaved(int64_t in, int64_t out, const a
   auto compare = [&](const auto& a, const auto& b) {
     REQUIRE(a.size() == b.size());
     double d = 0, m = 0;
-    for (size_t k = 0; k < a.size(); ++k) d = std::max(d, double(std::abs(a[k] - b[k]))), m = std::max(m, double(std::abs(b[k])));
+    for (size_t k = 0; k < a.size(); ++k)
+      d = std::max(d, double(std::abs(a[k] - b[k]))), m = std::max(m, double(std::abs(b[k])));
     worst = std::max(worst, d / m);
   };
   compare(ya.values(), yb.values());

@@ -150,8 +150,7 @@ TEST_CASE("MLPBlock: forward matches its definition / float64 gradient check wit
   // 1.6e-6 of the largest bias gradient; at 2e-6 it is half that.
   ag::GradCheckOptions opt;
   opt.step = 2e-6;
-  const auto r =
-      ag::gradcheck([&](const std::vector<ag::Tensord>&) { return blk.forward(inputs[0]); }, inputs, opt);
+  const auto r = ag::gradcheck([&](const std::vector<ag::Tensord>&) { return blk.forward(inputs[0]); }, inputs, opt);
   CHECK_MESSAGE(r.max_rel_error < 1e-6, r.report());
   blk.zero_grad();
   ag::sum(ag::mul(blk.forward(x), blk.forward(x))).backward();

@@ -60,7 +60,8 @@ struct DegenerateCase {
   gdsr::Points3 P;
 };
 inline std::vector<DegenerateCase> degenerate_cases(const gdsr::Points3& P, int a, int b, int c) {
-  std::vector<DegenerateCase> out{{"sliver of 1e-9 m", sliver(P, a, b, c, 1e-9)}, {"zero area", sliver(P, a, b, c, 0.0)}};
+  std::vector<DegenerateCase> out{{"sliver of 1e-9 m", sliver(P, a, b, c, 1e-9)},
+                                  {"zero area", sliver(P, a, b, c, 0.0)}};
   gdsr::Points3 Q = P;
   Q.row(c) = Q.row(b);
   out.push_back({"coincident vertices", Q});

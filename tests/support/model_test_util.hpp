@@ -112,8 +112,8 @@ inline std::unique_ptr<gdsr::GDSR<double>> model_in_units(const gdsr::GDSR<doubl
 
 // A frame in units s x metre (positions and body points scaled, body normals unit-free).
 inline gdsr::FrameInput frame_in_units(gdsr::FrameInput in, double s) {
-  for (gdsr::Points3* P : {&in.C_t, &in.C_tm1, &in.C_tm2, &in.Chat_tm1, &in.Chat_tm2, &in.contact_t.point,
-                           &in.contact_tm1.point})
+  for (gdsr::Points3* P :
+       {&in.C_t, &in.C_tm1, &in.C_tm2, &in.Chat_tm1, &in.Chat_tm2, &in.contact_t.point, &in.contact_tm1.point})
     *P *= s;
   return in;
 }

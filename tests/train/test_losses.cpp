@@ -402,8 +402,8 @@ TEST_CASE("losses: one degenerate triangle in a fine patch cannot dominate a tra
     std::string terms;
     for (const char* term : {"f_position", "f_image_l1", "f_strain", "f_smooth"}) {
       const std::vector<double> m = vertex_gradients(pred, only(term));
-      terms += std::string(" ") + term + " " +
-               std::to_string(std::max({m[row_of(a)], m[row_of(b)], m[row_of(c)]}) / median);
+      terms +=
+          std::string(" ") + term + " " + std::to_string(std::max({m[row_of(a)], m[row_of(b)], m[row_of(c)]}) / median);
     }
     MESSAGE(name << ": " << worst / median << " x the healthy median;" << terms);
     CHECK(worst < 100 * median);

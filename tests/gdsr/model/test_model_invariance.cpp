@@ -165,8 +165,7 @@ TEST_CASE("model invariance: a change of length units (x1e-3 and x1e3 and x1e-5)
         if (e > worst) worst = e, worst_name = params[i].first + "[" + std::to_string(j) + "]";
       }
     }
-    MESSAGE("x" << s << ": worst relative difference of a parameter gradient " << worst << " at "
-                    << worst_name);
+    MESSAGE("x" << s << ": worst relative difference of a parameter gradient " << worst << " at " << worst_name);
     CHECK(worst < 1e-10);
     // The test can fail: the model without the conversion is not equivariant.
     const Run raw = run(model, gdsr_test::frame_in_units(in, s), s);
