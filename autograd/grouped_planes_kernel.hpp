@@ -192,6 +192,8 @@ template <class R> void backward_x(const std::complex<R>* g, const CView<R>& W, 
 
 // The planes of W [out x in] transposed into t_re, t_im [in x out]: L x L tiles through
 // registers, the ragged edges element by element.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wignored-attributes"  // PacketBlock of an SIMD type, as Eigen's own code has
 template <class R> void transpose_planes(const CView<R>& W, int64_t out, int64_t in, Buffer<R>& t_re, Buffer<R>& t_im) {
   using namespace Eigen::internal;
   using P = Packet<R>;
@@ -213,6 +215,7 @@ template <class R> void transpose_planes(const CView<R>& W, int64_t out, int64_t
       for (int64_t i = o < ot ? it : 0; i < in; ++i) dst[i * out + o] = src[o * in + i];
   }
 }
+#pragma GCC diagnostic pop
 
 // y[n x out] += x W^T for one group (y holds the bias or zeros on entry): W transposed into
 // scratch once, then the outputs in the lanes.
