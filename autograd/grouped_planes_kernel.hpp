@@ -107,11 +107,14 @@ inline void lanes_block(const std::complex<R>* a, const CView<R>& M, std::comple
     for (int p = 0; p < JP; ++p) add_interleaved<R>(dst + r * J + j0 + p * L, re[r][p], im[r][p]);
 }
 
-// Few rows: wider column blocks, so that enough independent accumulators hide the FMA latency.
+// Packets per column block for a pass of `rows` rows: few rows get wider blocks, so that
+// enough independent accumulators hide the FMA latency.
+constexpr int column_packets(int64_t rows) { return rows <= 3 ? 4 : 2; }
+
 template <class R, bool Conj, int RB, int KD, int JD>
 void lanes_rows(const std::complex<R>* a, const CView<R>& M, std::complex<R>* dst, int64_t K, int64_t J,
                 const CView<R>* next = nullptr, int64_t* pf_line = nullptr, int64_t pf_lines = 0, int pf_per_k = 0) {
-  constexpr int L = kLanes<R>, JP = RB <= 3 ? 4 : 2;
+  constexpr int L = kLanes<R>, JP = column_packets(RB);
   int64_t j = 0;
   for (; j + JP * L <= J; j += JP * L) {
     const char* pr = nullptr;
@@ -136,34 +139,21 @@ template <class R, bool Conj, int KD, int JD> void lanes_product_impl(const std:
   // each plane per step of k, spread over all column blocks of this group.
   const int64_t passes = (n + RB - 1) / RB, per_pass = (n + passes - 1) / passes;  // 7 rows: 4 + 3
   int64_t blocks = 0;
-  for (int64_t r0 = 0; r0 < n; r0 += per_pass) blocks += J / ((std::min<int64_t>(per_pass, n - r0) <= 3 ? 4 : 2) * L);
+  for (int64_t r0 = 0; r0 < n; r0 += per_pass) blocks += J / (column_packets(std::min<int64_t>(per_pass, n - r0)) * L);
   int64_t pf_line = 0;
   const int64_t pf_lines = (K * J * int64_t(sizeof(R)) + 63) / 64;
   const int pf_per_k = blocks > 0 ? static_cast<int>((pf_lines + blocks * K - 1) / (blocks * K)) : 0;
+  // The row count as a template constant, so that the accumulators stay in registers.
+  using RowsFn = void (*)(const std::complex<R>*, const CView<R>&, std::complex<R>*, int64_t, int64_t, const CView<R>*,
+                          int64_t*, int64_t, int);
+  static constexpr RowsFn rows_kernel[RB] = {lanes_rows<R, Conj, 1, KD, JD>, lanes_rows<R, Conj, 2, KD, JD>,
+                                             lanes_rows<R, Conj, 3, KD, JD>, lanes_rows<R, Conj, 4, KD, JD>,
+                                             lanes_rows<R, Conj, 5, KD, JD>, lanes_rows<R, Conj, 6, KD, JD>};
   for (int64_t r0 = 0; r0 < n; r0 += per_pass) {
     const int64_t rows = std::min<int64_t>(per_pass, n - r0);
     const std::complex<R>* ar = a + r0 * K;
     std::complex<R>* dr = dst + r0 * J;
-    switch (rows) {  // the row count as a constant: the accumulators stay in registers
-      case 1:
-        lanes_rows<R, Conj, 1, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k);
-        break;
-      case 2:
-        lanes_rows<R, Conj, 2, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k);
-        break;
-      case 3:
-        lanes_rows<R, Conj, 3, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k);
-        break;
-      case 4:
-        lanes_rows<R, Conj, 4, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k);
-        break;
-      case 5:
-        lanes_rows<R, Conj, 5, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k);
-        break;
-      default:
-        lanes_rows<R, Conj, RB, KD, JD>(ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k);
-        break;
-    }
+    rows_kernel[rows - 1](ar, M, dr, K, J, next, &pf_line, pf_lines, pf_per_k);
     for (int64_t j = J / L * L; j < J; ++j)  // columns beyond the whole packets
       for (int64_t r = 0; r < rows; ++r) {
         std::complex<R> acc(0);
