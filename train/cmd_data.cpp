@@ -64,7 +64,7 @@ struct MakeArgs {
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN, self_slack = NAN;
   bool self_collision = true;
   bool independent_hr = false;  // settle HR from its own placement, not from the settled LR garment
-  bool skip_built = false;  // keep --out when it already holds this clip, built and valid
+  bool skip_built = false;      // keep --out when it already holds this clip, built and valid
   int rest_blend_frames = 15;
   int raster = 1024;
   int intersection_stride = kDefaultIntersectionStride;
@@ -154,11 +154,15 @@ void run_make(const MakeArgs& a) {
   bo.rest_blend_frames = a.rest_blend_frames;
   bo.start_seconds = a.start;
   bo.max_seconds = a.seconds;
+  bo.rest_arm_drop_degrees = sim::rest_arm_drop_degrees(a.garment);
   const double t_body = now_seconds();
   const gdsr::BodySequence body = gdsr::load_body_sequence(a.motion, bo);
   std::printf("body: %s, %d frames at %g fps (%d rest blend), %ld vertices, %.1f s\n", a.motion.c_str(),
               body.num_frames(), body.fps, body.rest_blend_frames, static_cast<long>(body.rest_V.rows()),
               now_seconds() - t_body);
+  if (bo.rest_arm_drop_degrees >= 0)
+    std::printf("body: rest pose with the upper arms %g degrees below level (the %s is cut for it)\n",
+                bo.rest_arm_drop_degrees, a.garment.c_str());
   if (!body.torso_found)
     std::fprintf(stderr,
                  "warning: %s: no hips and shoulders found among the skeleton's joint names; the body is a "
@@ -221,6 +225,7 @@ void run_make(const MakeArgs& a) {
                   {"settle_damping_1_s", params.settle_damping},
                   {"settle_rest_blend", params.settle_rest_blend},
                   {"hr_start", hr_start_name(a)},
+                  {"rest_arm_drop_degrees", bo.rest_arm_drop_degrees},
                   {"self_collision", params.self_collision},
                   {"self_thickness_m", params.self_thickness},
                   {"self_thickness_per_pd", params.self_thickness_per_pd},
@@ -584,7 +589,9 @@ void add_data_command(CLI::App& app) {
       ->check(finite_range(0.0, 2.0));
   make->add_option("--bend-stiffness", mk->bend_stiffness, "bending modulus, N m (default: the solver's)")
       ->check(finite_range(0.0, 1.0));
-  make->add_option("--self-thickness", mk->self_thickness, "least cloth-cloth distance kept, metres (default: the solver's; the solver also keeps 1/6 of the particle distance)")
+  make->add_option("--self-thickness", mk->self_thickness,
+                   "least cloth-cloth distance kept, metres (default: the solver's; the solver also keeps 1/6 of the "
+                   "particle distance)")
       ->check(finite_range(0.0, 0.05));
   make->add_option("--self-slack", mk->self_slack,
                    "metres a vertex may leave its predicted path before self-contacts are re-detected"
@@ -594,7 +601,8 @@ void add_data_command(CLI::App& app) {
                    "substeps between self-contact detections (default: the solver's)")
       ->check(CLI::Range(1, 1000));
   make->add_option("--compression-ratio", mk->compression_ratio,
-                   "in-plane compression stiffness / stretch stiffness at a 10 mm particle distance, scaled by (0.01 m / pd)^2 (default: the solver's)")
+                   "in-plane compression stiffness / stretch stiffness at a 10 mm particle distance, scaled by (0.01 m "
+                   "/ pd)^2 (default: the solver's)")
       ->check(finite_range(1e-4, 1.0));
   make->add_option("--contact-every", mk->contact_every,
                    "substeps between body contact refreshes (default: the solver's)")
@@ -622,7 +630,8 @@ void add_data_command(CLI::App& app) {
                                   "dataset recipe (JSON: garments x clips, train / held-out split, see "
                                   "configs/recipe_paper.json): builds each clip into --out/<name>, skipping those "
                                   "already built and valid; an interrupted run continues where it stopped");
-  for (const char* flag : {"--garment", "--motion", "--lr-pd", "--hr-pd", "--seconds", "--start", "--fps", "--rest-blend"})
+  for (const char* flag :
+       {"--garment", "--motion", "--lr-pd", "--hr-pd", "--seconds", "--start", "--fps", "--rest-blend"})
     recipe->excludes(make->get_option(flag));
   make->callback([mk]() {
     if (mk->recipe.empty())

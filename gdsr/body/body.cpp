@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <stdexcept>
 
@@ -338,17 +339,17 @@ SkeletonNodes skeleton_nodes(const Rig& rig, const std::vector<Mat4>& G, const s
   return out;
 }
 
-// A rest pose with the arms hanging down (the CMU 131 walks) would fuse the arms to the
-// body's sides when it is built, and give garments a waist as wide as the elbows. Each upper
-// arm more than 60 degrees below the horizontal is turned about its shoulder to point
-// sideways, level: a T-pose. T- and A-poses are left exactly as they are.
-void raise_hanging_arms(Rig& rig, const std::string& path) {
-  const std::vector<Mat4> G = rig.globals(rig.rest);
+// Turns each upper arm of the local transforms `pose` for which turn(arm direction) holds
+// about its shoulder, to point sideways (away from the other shoulder) `below` radians under
+// the horizontal. Rigs without two recognisable upper arms are left as they are.
+void turn_upper_arms(const Rig& rig, std::vector<Trs>& pose, const std::string& path, double below,
+                     const std::function<bool(const Vec3& arm)>& turn) {
+  const std::vector<Mat4> G = rig.globals(pose);
   const SkeletonNodes sn = skeleton_nodes(rig, G, path);
   const std::vector<int> arms = detail::upper_arm_starts(sn.nodes);
   if (arms.size() != 2) return;
   const Vec3 mid = 0.5 * (sn.nodes[arms[0]].pos + sn.nodes[arms[1]].pos);
-  for (int a : arms) {
+  for (int a : arms) {  // neither arm is the other's ancestor: G stays valid for both
     const Vec3 shoulder = sn.nodes[a].pos;
     int elbow = -1;  // the child farthest from the shoulder
     for (size_t k = 0; k < sn.nodes.size(); ++k)
@@ -359,14 +360,23 @@ void raise_hanging_arms(Rig& rig, const std::string& path) {
     const Vec3 arm = (sn.nodes[elbow].pos - shoulder).normalized();
     Vec3 side = shoulder - mid;
     side.y() = 0;
-    if (arm.y() > -std::sin(60 * M_PI / 180) || side.norm() < 1e-9) continue;
+    if (!turn(arm) || side.norm() < 1e-9) continue;
+    const Vec3 target = std::cos(below) * side.normalized() - std::sin(below) * Vec3::UnitY();
     // Global rotation Q about the shoulder: the local rotation becomes Rp^-1 Q Rp r.
-    const Quat Q = Quat::FromTwoVectors(arm, side.normalized());
+    const Quat Q = Quat::FromTwoVectors(arm, target);
     const int r = sn.to_rig[a], par = rig.parent[r];
     const Mat4& Gp = par >= 0 ? G[par] : rig.pre;
     const Eigen::Matrix3d Rp = Gp.topLeftCorner<3, 3>();
-    rig.rest[r].r = Quat(Rp.inverse() * Q.toRotationMatrix() * Rp * rig.rest[r].r.toRotationMatrix()).normalized();
+    pose[r].r = Quat(Rp.inverse() * Q.toRotationMatrix() * Rp * pose[r].r.toRotationMatrix()).normalized();
   }
+}
+
+// A rest pose with the arms hanging down (the CMU 131 walks) would fuse the arms to the
+// body's sides when it is built, and give garments a waist as wide as the elbows. Each upper
+// arm more than 60 degrees below the horizontal is turned about its shoulder to point
+// sideways, level: a T-pose. T- and A-poses are left exactly as they are.
+void raise_hanging_arms(Rig& rig, const std::string& path) {
+  turn_upper_arms(rig, rig.rest, path, 0, [](const Vec3& arm) { return arm.y() <= -std::sin(60 * M_PI / 180); });
 }
 
 // The body surface with its skin: the file's skinned meshes, or a body built around the
@@ -519,9 +529,10 @@ BodyLandmarks measure_landmarks(const TriMesh& rest, const Surface& surf, const 
 
 BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_only) {
   if (!(opt.fps > 0) || !(opt.height > 0) || opt.rest_blend_frames < 0 || !(opt.start_seconds >= 0) ||
-      !(opt.body_edge > 0))
+      !(opt.body_edge > 0) || !(opt.rest_arm_drop_degrees <= 80))
     gdsr::fail("load_body_sequence: " + path,
-               "bad BodyOptions (fps, height, body_edge must be > 0, rest_blend_frames and start_seconds >= 0)");
+               "bad BodyOptions (fps, height, body_edge must be > 0, rest_blend_frames and start_seconds >= 0, "
+               "rest_arm_drop_degrees <= 80)");
   if (!std::ifstream(path).good()) gdsr::fail("load_body_sequence: " + path, "file not found or not readable");
   Assimp::Importer imp;
   const aiScene* s =
@@ -556,10 +567,16 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
   seq.source = path;
   seq.from_skeleton = !clip.skinned;
   seq.torso_found = clip.skinned || surf.sb.torso_found;
-  seq.rest_V = to_out(rest_raw);
+  // Frame 0, where garments are put on: the file's rest pose, or its A-pose (placed, scaled
+  // and meshed as the file's rest pose, so every later frame is the same either way).
+  std::vector<Trs> start_local = rest_local;
+  if (opt.rest_arm_drop_degrees >= 0)
+    turn_upper_arms(clip.rig, start_local, path, opt.rest_arm_drop_degrees * M_PI / 180,
+                    [](const Vec3&) { return true; });
+  seq.rest_V = opt.rest_arm_drop_degrees >= 0 ? to_out(surf.sk.apply(clip.rig.globals(start_local))) : to_out(rest_raw);
   seq.rest_blend_frames = rest_only ? 0 : opt.rest_blend_frames;
   if (!rest_only)
-    seq.frames = animate(clip, surf.sk, to_out, rest_local, first, opt.rest_blend_frames, n_motion, opt, path);
+    seq.frames = animate(clip, surf.sk, to_out, start_local, first, opt.rest_blend_frames, n_motion, opt, path);
   seq.landmarks = measure_landmarks(TriMesh{seq.rest_V, seq.F}, surf, to_out, clip.skinned, opt.height);
   return seq;
 }

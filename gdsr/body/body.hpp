@@ -45,6 +45,12 @@ struct BodyOptions {
   // the motion: when the first key differs from the second by a much larger rotation than
   // the second from the third, the clip is taken to start at the second key.
   bool skip_calibration_key = true;
+  // The rest pose (frame 0, where garments are put on) with each upper arm turned about its
+  // shoulder to point sideways this many degrees below the horizontal (45: an A-pose; the
+  // t-shirt's sleeves are cut for it). < 0: the file's rest pose. The body mesh, its scale
+  // and its placement come from the file's rest pose either way: only frame 0 and the rest
+  // blend from it change; every motion frame after the blend is the same.
+  double rest_arm_drop_degrees = -1;
 };
 
 // A horizontal cross-section of the rest-pose body (torso only: points within 0.35 m of

@@ -49,8 +49,8 @@ std::vector<double> section_profile(const gdsr::TriMesh& b, const Vec3& axis, do
       const Eigen::Vector2d e = pts[1] - pts[0];
       const double den = d.x() * e.y() - d.y() * e.x();
       if (std::abs(den) < 1e-15) continue;
-      const double t = (pts[0].x() * e.y() - pts[0].y() * e.x()) / den;           // along the ray
-      const double u = (pts[0].x() * d.y() - pts[0].y() * d.x()) / den;           // along the segment
+      const double t = (pts[0].x() * e.y() - pts[0].y() * e.x()) / den;  // along the ray
+      const double u = (pts[0].x() * d.y() - pts[0].y() * d.x()) / den;  // along the segment
       if (u >= 0 && u <= 1 && t > 0 && t < max_r) r[k] = std::max(r[k], t);
     }
   }
@@ -115,16 +115,16 @@ void measure_legs(const gdsr::TriMesh& b, BodyLandmarks& lm) {
   }
 }
 
-// Arms: the vertices above the armpits and clear of the trunk on each side, their principal
-// line, the shoulder joint on it at the trunk's side and the wrist at the narrowest section
-// of the outer part of the arm.
+// Arms: the vertices clear of the trunk on each side above the lowest height an A-pose hand
+// reaches, their principal line, the shoulder joint on it at the trunk's side and the wrist
+// at the narrowest section before the hand.
 void measure_arms(const gdsr::TriMesh& b, BodyLandmarks& lm) {
   const double s = lm.height / 1.75;
   for (int k = 0; k < 2; ++k) {
     const int side = k == 0 ? 1 : -1;
     std::vector<Vec3> pts;
     for (int v = 0; v < b.V.rows(); ++v)
-      if (side * (b.V(v, 0) - lm.axis.x()) > 0.25 * s && b.V(v, 1) > lm.armpit_y - 0.15 * s) pts.push_back(b.V.row(v));
+      if (side * (b.V(v, 0) - lm.axis.x()) > 0.25 * s && b.V(v, 1) > lm.armpit_y - 0.45 * s) pts.push_back(b.V.row(v));
     if (pts.size() < 30) continue;
     Vec3 m = Vec3::Zero();
     for (const auto& p : pts) m += p;
@@ -149,9 +149,12 @@ void measure_arms(const gdsr::TriMesh& b, BodyLandmarks& lm) {
       const int i = static_cast<int>((t - t_root) / (0.01 * s));
       if (i >= 0 && i < nb) rad[i] = std::max(rad[i], ((p - m) - t * d).norm());
     }
-    int wrist = nb - 1;
-    for (int i = static_cast<int>(0.55 * nb); i < nb - 3; ++i)
-      if (rad[i] > 0 && rad[i] < rad[wrist]) wrist = i;
+    // The wrist: the narrowest section between 70% and 90% of the way from the shoulder joint
+    // to the fingertips (beyond it the hand widens again, then the fingertips narrow).
+    int wrist = -1;
+    for (int i = static_cast<int>(0.7 * nb); i <= static_cast<int>(0.9 * nb) && i < nb; ++i)
+      if (rad[i] > 0 && (wrist < 0 || rad[i] < rad[wrist])) wrist = i;
+    if (wrist < 0) continue;
     double r = 0;
     for (int i = static_cast<int>(0.08 * s / (0.01 * s)); i <= wrist; ++i) r = std::max(r, rad[i]);
     lm.arm_found[k] = true;
@@ -159,6 +162,7 @@ void measure_arms(const gdsr::TriMesh& b, BodyLandmarks& lm) {
     lm.arm_dir[k] = d;
     lm.arm_len[k] = (wrist + 0.5) * 0.01 * s;
     lm.arm_r[k] = r;
+    lm.wrist_r[k] = rad[wrist];
   }
 }
 

@@ -37,11 +37,12 @@ struct BodyLandmarks {
   // Arms (index 0: +x side, 1: -x side), found when the arm stands clear of the trunk (T- or
   // A-pose): a centre line from the shoulder joint `arm_root` along the unit `arm_dir`
   // (outwards) to the wrist at arm_root + arm_len * arm_dir; arm_r: the largest distance of
-  // the arm's surface from that line between shoulder and wrist.
+  // the arm's surface from that line between shoulder and wrist; wrist_r: that distance at the
+  // wrist (the narrowest section between 70% and 90% of the way to the fingertips).
   bool arm_found[2] = {false, false};
   gdsr::Vec3 arm_root[2] = {gdsr::Vec3::Zero(), gdsr::Vec3::Zero()};
   gdsr::Vec3 arm_dir[2] = {gdsr::Vec3::UnitX(), -gdsr::Vec3::UnitX()};
-  double arm_len[2] = {0, 0}, arm_r[2] = {0, 0};
+  double arm_len[2] = {0, 0}, arm_r[2] = {0, 0}, wrist_r[2] = {0, 0};
 };
 
 // Distance of the trunk's waist section from the axis in direction psi (radians, see
@@ -73,8 +74,8 @@ class WaistCurve {
   double weight(double below) const;
 
  private:
-  std::vector<double> r_;    // m, radius at psi_k = 2 pi k / n (ease included)
-  std::vector<double> arc_;  // m, arc length from psi_0 to psi_k, k = 0..n (arc_[n]: the perimeter)
+  std::vector<double> r_;       // m, radius at psi_k = 2 pi k / n (ease included)
+  std::vector<double> arc_;     // m, arc length from psi_0 to psi_k, k = 0..n (arc_[n]: the perimeter)
   double ease_ = 0, drop_ = 0;  // m
 };
 

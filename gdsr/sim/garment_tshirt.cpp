@@ -2,12 +2,15 @@
 // Torso: an elliptic cylinder (semi-axes A sideways, B front-back) around the trunk, cut
 // into a front and a back panel (side seams at the ellipse's sides); above the shoulder
 // line each panel folds horizontally inwards to the shoulder seam (the shoulder top is a
-// horizontal plane with an elliptic neck opening). Sleeves: a circular tube of radius rs
-// around each arm's centre line from the torso to the wrist, one panel per sleeve with its
-// seam under the arm. The armhole is the exact intersection curve of sleeve tube and torso
-// cylinder, so both developments are isometric (cylinders) and the sleeve cap sews edge by
-// edge to the armhole of the front and back panels. Only the shoulder fold is not
-// isometric (shear where the ellipse turns sideways). No pins: it hangs on the shoulders.
+// horizontal plane with an elliptic neck opening). Sleeves: a circular cone around each
+// arm's centre line from the torso to the wrist (radius rs at the shoulder joint, tapering to
+// a cuff kCuffEase over the wrist), one panel per sleeve (a sector of a ring) with its seam
+// under the arm. The armhole is the exact intersection curve of sleeve cone and torso
+// cylinder, so both developments are isometric and the sleeve cap sews edge by edge to the
+// armhole of the front and back panels. Only the shoulder fold is not isometric (shear where
+// the ellipse turns sideways). No pins: it hangs on the shoulders. Cut for an A-pose rest
+// (sim::rest_arm_drop_degrees): cut for a T-pose, the sleeves were short over the top of the
+// arm once the arms came down and dragged the shoulders off a salsa dancer.
 #include "gdsr/error.hpp"
 #include "gdsr/sim/garment_design.hpp"
 
@@ -25,13 +28,34 @@ using gdsr::Vec3;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr int kHole = 10;  // armhole edges per torso panel (a sleeve cap has 2 kHole)
+constexpr int kHole = 10;           // armhole edges per torso panel (a sleeve cap has 2 kHole)
+constexpr int kCuff = 8;            // edges of the cuff (an arc of the sleeve's flat ring)
+constexpr double kCuffEase = 0.03;  // metres (x height / 1.75) of the cuff's radius over the wrist's
 
 struct Sleeve {
-  Vec3 root, d, e1, e2;  // centre line and frame: e1 down (perpendicular to d), e2 = e1 x d
-  double rs = 0, t_wrist = 0;
+  Vec3 root, d, e1, e2;                       // centre line and frame: e1 down (perpendicular to d), e2 = e1 x d
+  double rs = 0, slope = 0, t_wrist = 0;      // radius rs + slope t at distance t along d (slope <= 0)
   std::array<double, 2 * kHole + 1> theta{};  // theta[0]: bottom side-seam crossing, theta[kHole]: top
-  Vec3 at(double t, double th) const { return root + t * d + rs * (std::cos(th) * e1 + std::sin(th) * e2); }
+  Vec3 normal(double th) const { return std::cos(th) * e1 + std::sin(th) * e2; }
+  Vec3 at(double t, double th) const { return root + t * d + (rs + slope * t) * normal(th); }
+  // The cone's development: the generator theta = theta[0] + a runs along the flat x axis
+  // from the shoulder joint (x = 0) with a the angle round the arm (0 to 2 pi), flat y > 0.
+  // Exact for a cone (a sector of a ring around the apex beyond the wrist), the rectangle
+  // (t, rs a) for a cylinder.
+  bool cone() const { return slope < -1e-9; }
+  double slant() const { return std::sqrt(1 + slope * slope); }
+  double apex() const { return -rs / slope; }  // t of the apex (cone only)
+  Vec2 flat(double t, double a) const {
+    if (!cone()) return Vec2(t, rs * a);
+    const double rho = (apex() - t) * slant(), phi = a * -slope / slant();
+    return Vec2(apex() * slant() - rho * std::cos(phi), rho * std::sin(phi));
+  }
+  Vec3 unflat(const Vec2& q) const {
+    if (!cone()) return at(q.x(), theta[0] + q.y() / rs);
+    const double dx = apex() * slant() - q.x();
+    const double t = apex() - std::hypot(dx, q.y()) / slant();
+    return at(t, theta[0] + std::atan2(q.y(), dx) / (-slope / slant()));
+  }
 };
 
 struct Shirt {
@@ -51,10 +75,10 @@ struct Shirt {
                              static_cast<int>(arc.size()) - 2);
     return psi[i] + (s - arc[i]) / (arc[i + 1] - arc[i]) * (psi[i + 1] - psi[i]);
   }
-  // Exit parameter t of the sleeve line at angle th through the torso cylinder.
+  // Exit parameter t of the sleeve's generator at angle th through the torso cylinder.
   double hit(const Sleeve& q, double th) const {
-    const Vec3 p0 = q.at(0, th);
-    const double q0 = (p0.x() - cx) / A, q1 = q.d.x() / A, w0 = (p0.z() - cz) / B, w1 = q.d.z() / B;
+    const Vec3 p0 = q.at(0, th), dir = q.d + q.slope * q.normal(th);  // t along d: n(th) is normal to d
+    const double q0 = (p0.x() - cx) / A, q1 = dir.x() / A, w0 = (p0.z() - cz) / B, w1 = dir.z() / B;
     const double a = q1 * q1 + w1 * w1, b = q0 * q1 + w0 * w1, c = q0 * q0 + w0 * w0 - 1;
     const double disc = b * b - a * c;
     if (!(disc >= 0) || a < 1e-12) gdsr::fail("sim/garment_tshirt", "sleeve line misses the torso cylinder");
@@ -88,8 +112,12 @@ GarmentDesign design_tshirt(const BodyLandmarks& lm) {
   T.hem_y = lm.hip_y + 0.4 * (lm.waist_y - lm.hip_y);
   T.cx = lm.axis.x();
   T.cz = 0.5 * (lm.arm_root[0].z() + lm.arm_root[1].z());  // side seams in the arms' plane
-  double rs = 0;
-  for (int k = 0; k < 2; ++k) rs = std::max(rs, lm.arm_r[k] + 0.02 * s);
+  double rs = 0, rw = 0;                                   // sleeve radius at the shoulder joint and at the cuff
+  for (int k = 0; k < 2; ++k) {
+    rs = std::max(rs, lm.arm_r[k] + 0.02 * s);
+    rw = std::max(rw, lm.wrist_r[k] + kCuffEase * s);
+  }
+  rw = std::min(rw, rs);
   T.A = std::max({lm.trunk_hi.x() - T.cx, T.cx - lm.trunk_lo.x()}) + ease;
   T.A = std::max({T.A, std::abs(lm.arm_root[0].x() - T.cx) + 0.01 * s, std::abs(lm.arm_root[1].x() - T.cx) + 0.01 * s});
   T.B = std::max({lm.trunk_hi.z() - T.cz, T.cz - lm.trunk_lo.z(), rs + 0.03 * s}) + ease;
@@ -114,6 +142,8 @@ GarmentDesign design_tshirt(const BodyLandmarks& lm) {
     q.root = lm.arm_root[k];
     q.d = lm.arm_dir[k];
     q.rs = rs;
+    q.t_wrist = lm.arm_len[k];
+    q.slope = (rw - rs) / q.t_wrist;
     q.e1 = (-Vec3::UnitY() + q.d * q.d.y()).normalized();
     q.e2 = q.e1.cross(q.d);
     auto f = [&](double th) { return q.at(T.hit(q, th), th).z() - T.cz; };
@@ -140,7 +170,6 @@ GarmentDesign design_tshirt(const BodyLandmarks& lm) {
       y_hole_top = std::max(y_hole_top, q.at(t, q.theta[j]).y());
       y_hole_bot = std::min(y_hole_bot, q.at(t, q.theta[j]).y());
     }
-    q.t_wrist = lm.arm_len[k];
     if (q.t_wrist < t_max + 0.15 * s) gdsr::fail("sim/garment_tshirt", "arm too short for a sleeve");
   }
   const double y_top = std::max(lm.shoulder_top_y, y_hole_top + 0.01 * s) + 0.02 * s;
@@ -208,21 +237,23 @@ GarmentDesign design_tshirt(const BodyLandmarks& lm) {
     for (auto& v : o) v += T.origin[panel];
     p.panels.push_back({panel == 0 ? "tshirt_front" : "tshirt_back", o});
   }
-  // Sleeves: u = t along the arm, v = rs (theta - theta_0).
+  // Sleeves (Sleeve::flat): edge 0 and edge kCuff + 1 are the underarm seam's two sides,
+  // edges 1..kCuff the cuff, then the cap from theta[2 kHole] back to theta[0].
+  const int cap0 = kCuff + 2;
   double x_off = T.origin[1].x() + T.S / 4 + gap;
   for (int k = 0; k < 2; ++k) {
     const Sleeve& q = T.sl[k];
-    const double V = 2 * kPi * q.rs;
-    double umin = 1e300;
-    std::vector<double> u(2 * kHole + 1);
-    for (int j = 0; j <= 2 * kHole; ++j) umin = std::min(umin, u[j] = T.hit(q, q.theta[j]));
-    T.origin[2 + k] = Vec2(x_off - umin, 0);
-    std::vector<Vec2> o{Vec2(u[0], 0), Vec2(q.t_wrist, 0), Vec2(q.t_wrist, V)};
-    for (int j = 2 * kHole; j >= 1; --j) o.push_back(Vec2(u[j], q.rs * (q.theta[j] - q.theta[0])));
-    for (auto& v : o) v += T.origin[2 + k];
-    x_off += q.t_wrist - umin + gap;
+    std::vector<Vec2> o{q.flat(T.hit(q, q.theta[0]), 0)};
+    for (int j = 0; j <= kCuff; ++j) o.push_back(q.flat(q.t_wrist, 2 * kPi * j / kCuff));
+    for (int j = 2 * kHole; j >= 1; --j) o.push_back(q.flat(T.hit(q, q.theta[j]), q.theta[j] - q.theta[0]));
+    double xmin = 1e300;
+    for (const auto& v : o) xmin = std::min(xmin, v.x());
+    T.origin[2 + k] = Vec2(x_off - xmin, 0);
+    double xmax = -1e300;
+    for (auto& v : o) xmax = std::max(xmax, (v += T.origin[2 + k]).x());
+    x_off = xmax + gap;
     p.panels.push_back({k == 0 ? "sleeve_right" : "sleeve_left", o});
-    p.seams.push_back({2 + k, 0, 2 + k, 2, true});  // underarm seam
+    p.seams.push_back({2 + k, 0, 2 + k, kCuff + 1, true});  // underarm seam
   }
   // Torso seams: side seams below and above the armholes, shoulder seams, armholes.
   for (int a = 0; a < 2; ++a) {
@@ -233,18 +264,17 @@ GarmentDesign design_tshirt(const BodyLandmarks& lm) {
   }
   for (int panel = 0; panel < 2; ++panel) {
     const int arm_r = panel == 0 ? 0 : 1, arm_l = 1 - arm_r;
-    // Cap edge for [theta_j, theta_j+1] is sleeve edge 3 + (2 kHole - 1 - j).
+    // Cap edge for [theta_j, theta_j+1] is sleeve edge cap0 + (2 kHole - 1 - j).
     for (int j = 0; j < kHole; ++j) {
-      p.seams.push_back({panel, E[panel].hole_r + j, 2 + arm_r, 3 + (2 * kHole - 1 - j), true});
-      p.seams.push_back({panel, E[panel].hole_l + j, 2 + arm_l, 3 + (2 * kHole - 1 - (kHole + j)), true});
+      p.seams.push_back({panel, E[panel].hole_r + j, 2 + arm_r, cap0 + (2 * kHole - 1 - j), true});
+      p.seams.push_back({panel, E[panel].hole_l + j, 2 + arm_l, cap0 + (2 * kHole - 1 - (kHole + j)), true});
     }
   }
   d.place = [sh](int panel, const Vec2& uv) {
     const Shirt& T = *sh;
     const Vec2 q = uv - T.origin[panel];
     if (panel < 2) return T.torso_place(panel, q);
-    const Sleeve& sl = T.sl[panel - 2];
-    return sl.at(q.x(), sl.theta[0] + q.y() / sl.rs);
+    return T.sl[panel - 2].unflat(q);
   };
   return d;
 }

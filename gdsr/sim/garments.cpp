@@ -14,6 +14,7 @@ namespace {
 struct CatalogueEntry {
   const char* name;
   GarmentDesign (*design)(const BodyLandmarks&);
+  double rest_arm_drop_degrees = -1;  // see rest_arm_drop_degrees()
 };
 
 // The garment catalogue: the one place a garment's name is looked up.
@@ -24,20 +25,22 @@ const CatalogueEntry kCatalogue[] = {
     {"shorts", design_shorts},
     {"skirt_layered", design_skirt_layered},
     // The paper's five training garment types.
-    {"tshirt", design_tshirt},
+    {"tshirt", design_tshirt, 45},
     {"pants", design_pants},
     {"skirt_pleated", design_skirt_pleated},
     {"dress_layered", design_dress_layered},
     {"skirt_tiered", design_skirt_tiered},
 };
 
-GarmentDesign design(const std::string& name, const BodyLandmarks& lm) {
+const CatalogueEntry& entry(const std::string& name) {
   for (const CatalogueEntry& e : kCatalogue)
-    if (name == e.name) return e.design(lm);
+    if (name == e.name) return e;
   std::string known;
   for (const CatalogueEntry& e : kCatalogue) known += std::string(known.empty() ? "" : ", ") + e.name;
   gdsr::fail("sim/garments", "unknown garment '" + name + "' (known: " + known + ")");
 }
+
+GarmentDesign design(const std::string& name, const BodyLandmarks& lm) { return entry(name).design(lm); }
 
 }  // namespace
 
@@ -46,6 +49,8 @@ std::vector<std::string> garment_names() {
   for (const CatalogueEntry& e : kCatalogue) names.push_back(e.name);
   return names;
 }
+
+double rest_arm_drop_degrees(const std::string& name) { return entry(name).rest_arm_drop_degrees; }
 
 Pattern garment_pattern(const std::string& name, const BodyLandmarks& lm) { return design(name, lm).pattern; }
 

@@ -25,6 +25,11 @@ struct Garment {
 // "dress_layered" (2 layers), "skirt_tiered" (long skirt with 3 lace tiers).
 std::vector<std::string> garment_names();
 
+// The rest pose a garment is cut for, as gdsr::BodyOptions::rest_arm_drop_degrees: 45 (an
+// A-pose) for the t-shirt, whose T-pose sleeves dragged the shoulders down off the body once
+// the arms came down; -1 (the motion file's rest pose) for the rest.
+double rest_arm_drop_degrees(const std::string& name);
+
 // The sewing pattern of a garment for a body (sizes follow the landmarks).
 Pattern garment_pattern(const std::string& name, const BodyLandmarks& lm);
 

@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <map>
 #include <string>
 
@@ -141,6 +142,48 @@ TEST_CASE("body: a rest pose with the arms hanging down is built in a T-pose") {
   // The motion itself is untouched: after the blend from rest, the arms hang down again.
   const Points3& last = walk.frames.back();
   CHECK(last.col(0).maxCoeff() - last.col(0).minCoeff() < 0.75 * span);
+}
+
+TEST_CASE("body: an A-pose rest turns the upper arms and leaves the body and the motion as they are") {
+  // The t-shirt is put on an A-pose (sim::rest_arm_drop_degrees): arms 45 degrees below level.
+  BodyOptions t, a;
+  t.max_seconds = a.max_seconds = 1;
+  a.rest_arm_drop_degrees = 45;
+  const BodySequence st = load_body_sequence(kBvhTest, t), sa = load_body_sequence(kBvhTest, a);
+  REQUIRE(st.rest_V.rows() == sa.rest_V.rows());
+  CHECK((st.F - sa.F).cwiseAbs().maxCoeff() == 0);  // the same mesh, built in the file's T-pose
+  // The arms' principal lines, measured on the mesh: level before, 45 degrees down after.
+  const sim::BodyLandmarks lt = sim::measure_body(st.rest_mesh()), la = sim::measure_body(sa.rest_mesh());
+  for (int k = 0; k < 2; ++k) {
+    CAPTURE(k);
+    REQUIRE(lt.arm_found[k]);
+    REQUIRE(la.arm_found[k]);
+    const double deg_t = std::asin(-lt.arm_dir[k].y()) * 180 / M_PI, deg_a = std::asin(-la.arm_dir[k].y()) * 180 / M_PI;
+    MESSAGE("arm below level: file's rest " << deg_t << " deg, A-pose " << deg_a << " deg");
+    CHECK(std::abs(deg_t) < 8);
+    CHECK(std::abs(deg_a - 45) < 5);
+    CHECK(la.arm_len[k] == doctest::Approx(lt.arm_len[k]).epsilon(0.08));  // the whole arm, hand not cut off
+  }
+  // Legs and trunk below the armpits do not move; the arms do.
+  int moved_low = 0, moved_arm = 0;
+  for (Eigen::Index v = 0; v < st.rest_V.rows(); ++v) {
+    const double d = (st.rest_V.row(v) - sa.rest_V.row(v)).norm();
+    if (st.rest_V(v, 1) < lt.armpit_y - 0.1) moved_low += d > 1e-9;
+    if (std::abs(st.rest_V(v, 0) - lt.axis.x()) > 0.4) moved_arm += d > 0.05;
+  }
+  CHECK(moved_low == 0);
+  CHECK(moved_arm > 50);
+  // After the rest blend the motion is the same, frame for frame.
+  REQUIRE(st.num_frames() == sa.num_frames());
+  for (int f = st.rest_blend_frames; f < st.num_frames(); ++f) CHECK(st.frames[f] == sa.frames[f]);
+  // Out of range: a clear error.
+  BodyOptions bad;
+  bad.rest_arm_drop_degrees = 95;
+  CHECK_THROWS_WITH_AS(load_body_sequence(kBvhTest, bad), doctest::Contains("rest_arm_drop_degrees"),
+                       std::runtime_error);
+  bad.rest_arm_drop_degrees = std::nan("");
+  CHECK_THROWS_WITH_AS(load_body_sequence(kBvhTest, bad), doctest::Contains("rest_arm_drop_degrees"),
+                       std::runtime_error);
 }
 
 TEST_CASE("body: a skeleton whose hips are not recognised says so") {
