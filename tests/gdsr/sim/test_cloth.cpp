@@ -193,22 +193,40 @@ TEST_CASE("cloth: a hand sweeping past the pinned waistband lets the cloth slip 
   CHECK(without > 3.0);
 }
 
+namespace {
+
+// The 30 mm t-shirt on 1 s (from 2 s) of a CMU salsa clip, put on the rest pose it is cut for.
+struct TshirtRun {
+  gdsr::BodySequence body;
+  sim::Garment garment;
+  std::vector<gdsr::Points3> frames;
+};
+TshirtRun tshirt_on_salsa(const std::string& clip) {
+  const std::string bvh = std::string(GDSR_SHARED_DIR) + "/motions/cmu-salsa/" + clip + ".bvh";
+  REQUIRE_MESSAGE(std::ifstream(bvh).good(), bvh << " is missing (../shared beside the repository)");
+  gdsr::BodyOptions opt;
+  opt.start_seconds = 2;
+  opt.max_seconds = 1;
+  opt.rest_arm_drop_degrees = sim::rest_arm_drop_degrees("tshirt");
+  REQUIRE(opt.rest_arm_drop_degrees == 45);
+  TshirtRun r{gdsr::load_body_sequence(bvh, opt), {}, {}};
+  r.garment = sim::make_garment("tshirt", 0.03, r.body.rest_mesh());
+  r.frames = sim::simulate(r.garment, r.body, sim::SimParams{});
+  return r;
+}
+
+}  // namespace
+
 TEST_CASE("cloth: a garment without pins is carried by the arms it is worn on") {
   // The release above lets only cloth that hangs from a pin slip. Applied to a t-shirt (no
   // pins) it let the salsa dancer's rising arm pass through the sleeve: at 30 mm, 33 of 46
   // frames had cloth more than 5 mm inside the body, and at 10 mm the shirt fell to the feet.
   // Carried by the body, 3 frames of 46 did on the T-pose cut and 5 do on the A-pose cut
   // (a handful: the hand reaches the hip).
-  const std::string bvh = std::string(GDSR_SHARED_DIR) + "/motions/cmu-salsa/61_02.bvh";
-  REQUIRE_MESSAGE(std::ifstream(bvh).good(), bvh << " is missing (../shared beside the repository)");
-  gdsr::BodyOptions opt;
-  opt.start_seconds = 2;
-  opt.max_seconds = 1;
-  opt.rest_arm_drop_degrees = sim::rest_arm_drop_degrees("tshirt");
-  const auto body = gdsr::load_body_sequence(bvh, opt);
-  const auto g = sim::make_garment("tshirt", 0.03, body.rest_mesh());
-  REQUIRE(g.pinned.empty());
-  const auto out = sim::simulate(g, body, sim::SimParams{});
+  const TshirtRun run = tshirt_on_salsa("61_02");
+  const auto& body = run.body;
+  const auto& out = run.frames;
+  REQUIRE(run.garment.pinned.empty());
   int deep = 0;
   for (size_t t = 0; t < out.size(); ++t) {
     REQUIRE(out[t].allFinite());
@@ -226,16 +244,9 @@ TEST_CASE("cloth: a t-shirt stays on a salsa dancer's shoulders and arms") {
   // definitions). Cut for an A-pose with tapered sleeves: every wrist within 4-6 cm of its
   // sleeve, and 0-12 such frames over small changes of the setup (the arms reach forward and
   // pull the back of the loose shirt off the shoulder blades for a moment).
-  const std::string bvh = std::string(GDSR_SHARED_DIR) + "/motions/cmu-salsa/60_02.bvh";
-  REQUIRE_MESSAGE(std::ifstream(bvh).good(), bvh << " is missing (../shared beside the repository)");
-  gdsr::BodyOptions opt;
-  opt.start_seconds = 2;
-  opt.max_seconds = 1;
-  opt.rest_arm_drop_degrees = sim::rest_arm_drop_degrees("tshirt");
-  REQUIRE(opt.rest_arm_drop_degrees == 45);
-  const auto body = gdsr::load_body_sequence(bvh, opt);
-  const auto g = sim::make_garment("tshirt", 0.03, body.rest_mesh());
-  const auto out = sim::simulate(g, body, sim::SimParams{});
+  const TshirtRun run = tshirt_on_salsa("60_02");
+  const auto& body = run.body;
+  const auto& out = run.frames;
   const gdsr::Points3& B0 = body.frames[0];
   const sim::BodyLandmarks lm = sim::measure_body(body.rest_mesh());
   // Body vertices followed through the motion: the top 2 cm of each shoulder (between neck
