@@ -135,6 +135,7 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
   if (opt.intersection_stride < 1) fail("validity", "intersection stride must be >= 1");
   if (!(opt.penetration_limit >= 0)) fail("validity", "penetration limit must be >= 0");
   if (!(opt.pinch_reach > 0) || !(opt.pinch_separation > 0)) fail("validity", "pinch reach and separation must be > 0");
+  if (!(opt.tear_stretch > 1)) fail("validity", "tear stretch must be > 1");
   const int T = static_cast<int>(d.lr_frames.size());
   if (T == 0 || d.hr_frames.size() != d.lr_frames.size())
     fail("validity", "the dataset has no frames (or LR/HR counts differ)");
@@ -142,6 +143,7 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
   v.frames = T;
   v.intersection_stride = opt.intersection_stride;
   v.penetration_limit = opt.penetration_limit;
+  v.tear_stretch = opt.tear_stretch;
   v.lr.faces = static_cast<int>(d.lr.F.rows());
   v.hr.faces = static_cast<int>(d.hr.F.rows());
   v.body_measured = opt.body && d.has_body();
@@ -155,6 +157,12 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
       r.strain.E_u += e.E_u / T;
       r.strain.E_v += e.E_v / T;
       r.strain.E_uv += e.E_uv / T;
+      const double stretch = max_edge_stretch(g, X);
+      r.torn_frames += stretch > opt.tear_stretch;
+      if (stretch > r.max_edge_stretch || r.max_edge_stretch_frame < 0) {
+        r.max_edge_stretch = stretch;
+        r.max_edge_stretch_frame = t;
+      }
       r.mean_curvature += wrinkle_measure(X, g.F).mean_curvature / T;
     };
     strain(d.lr, d.lr_frames[t], v.lr);
@@ -203,7 +211,13 @@ nlohmann::json resolution_json(const ResolutionValidity& r, bool body) {
                         {"max_pairs_frame", r.si_max_frame},
                         {"degenerate_faces", r.si_degenerate_faces},
                         {"skipped_faces", r.si_skipped_faces}}},
-                      {"strain", {{"E_u", r.strain.E_u}, {"E_v", r.strain.E_v}, {"E_uv", r.strain.E_uv}}},
+                      {"strain",
+                       {{"E_u", r.strain.E_u},
+                        {"E_v", r.strain.E_v},
+                        {"E_uv", r.strain.E_uv},
+                        {"max_edge_stretch", r.max_edge_stretch},
+                        {"max_edge_stretch_frame", r.max_edge_stretch_frame},
+                        {"torn_frames", r.torn_frames}}},
                       {"mean_curvature_1_m", r.mean_curvature}};
   if (body)
     j["body"] = {{"max_penetration_m", r.max_penetration},
@@ -242,6 +256,14 @@ ResolutionValidity resolution_from_json(const nlohmann::json& j, bool body, cons
   r.strain.E_u = take<double>(st, "E_u", where + "strain.");
   r.strain.E_v = take<double>(st, "E_v", where + "strain.");
   r.strain.E_uv = take<double>(st, "E_uv", where + "strain.");
+  // Manifests written before torn cloth was counted: not measured.
+  if (st.contains("torn_frames")) {
+    r.max_edge_stretch = take<double>(st, "max_edge_stretch", where + "strain.");
+    r.max_edge_stretch_frame = take<int>(st, "max_edge_stretch_frame", where + "strain.");
+    r.torn_frames = take<int>(st, "torn_frames", where + "strain.");
+  } else {
+    r.torn_frames = -1;
+  }
   r.mean_curvature = take<double>(j, "mean_curvature_1_m", where);
   if (body) {
     const auto b = take<nlohmann::json>(j, "body", where);
@@ -268,6 +290,7 @@ nlohmann::json validity_to_json(const ValidityFigures& v) {
   nlohmann::json j = {{"frames", v.frames},
                       {"intersection_stride", v.intersection_stride},
                       {"penetration_limit_m", v.penetration_limit},
+                      {"tear_stretch", v.tear_stretch},
                       {"body_measured", v.body_measured},
                       {"lr", resolution_json(v.lr, v.body_measured)},
                       {"hr", resolution_json(v.hr, v.body_measured)},
@@ -286,6 +309,7 @@ ValidityFigures validity_from_json(const nlohmann::json& j) {
   v.frames = take<int>(j, "frames", "");
   v.intersection_stride = take<int>(j, "intersection_stride", "");
   v.penetration_limit = take<double>(j, "penetration_limit_m", "");
+  if (j.contains("tear_stretch")) v.tear_stretch = take<double>(j, "tear_stretch", "");
   v.body_measured = take<bool>(j, "body_measured", "");
   v.body_crossing_frames = j.contains("body_crossing_frames") ? take<int>(j, "body_crossing_frames", "") : -1;
   v.lr = resolution_from_json(take<nlohmann::json>(j, "lr", ""), v.body_measured, "lr.");
@@ -333,6 +357,17 @@ std::string validity_table(const ValidityFigures& v) {
        ratio_str(v.strain_ratio_v()).c_str());
   line("  %-40s %14.5f %14.5f %9s\n", "strain: mean E_uv", v.lr.strain.E_uv, v.hr.strain.E_uv,
        ratio_str(v.strain_ratio_uv()).c_str());
+  if (v.lr.torn_frames >= 0 && v.hr.torn_frames >= 0) {
+    auto longest = [](const ResolutionValidity& r) {
+      char b[48];
+      std::snprintf(b, sizeof b, "%.2fx (f%3d)", r.max_edge_stretch, r.max_edge_stretch_frame);
+      return std::string(b);
+    };
+    line("  %-40s %14s %14s\n", "strain: longest edge / pattern (frame)", longest(v.lr).c_str(), longest(v.hr).c_str());
+    char label[64];
+    std::snprintf(label, sizeof label, "strain: frames with an edge > %gx", v.tear_stretch);
+    line("  %-40s %14d %14d\n", label, v.lr.torn_frames, v.hr.torn_frames);
+  }
   if (v.body_measured) {
     auto depth = [](const ResolutionValidity& r) {
       char b[48];

@@ -4,7 +4,9 @@
 //   - self-intersection: intersecting pairs of triangles per frame, CGAL
 //     (gdsr/geometry/self_intersections.hpp; pairs meeting only at a shared vertex/edge do not
 //     count), on every `intersection_stride`-th frame;
-//   - strain: mean E_u, E_v, E_uv against the sewing pattern (gdsr/geometry/strain.hpp);
+//   - strain: mean E_u, E_v, E_uv against the sewing pattern (gdsr/geometry/strain.hpp), and
+//     torn cloth: the longest edge over its pattern length and the frames with an edge
+//     longer than tear_stretch times it (a few dragged-out vertices that the means hide);
 //   - body: penetration depth = -signed distance to the body frame (Embree, exact closest
 //     point, gdsr/body/body_query.hpp), only when the dataset has a body; a penetrating
 //     vertex is "pinched" when a second body part is within pinch_reach of it (a body vertex
@@ -38,6 +40,7 @@ struct ValidityOptions {
   bool body = true;                  // false: skip the penetration even if the dataset has a body
   double pinch_reach = 0.04;         // metres: a second body part this close to a penetrating vertex pinches it
   double pinch_separation = 0.15;    // metres apart in the first frame: two points on different body parts
+  double tear_stretch = 2;           // frames with an edge longer than this times its pattern length are counted
 };
 
 // Figures of one resolution (LR or HR) over the clip.
@@ -54,6 +57,9 @@ struct ResolutionValidity {
   double si_clean_fraction() const { return si_frames > 0 ? static_cast<double>(si_clean_frames) / si_frames : 0; }
   // strain, means over frames of the per-frame means over triangles
   StrainEnergies strain;
+  double max_edge_stretch = 0;      // longest edge / pattern length, max over frames
+  int max_edge_stretch_frame = -1;  // its frame
+  int torn_frames = 0;              // frames with an edge longer than tear_stretch (-1: not measured)
   // body (only when measured)
   double max_penetration = 0;      // metres, max over frames and vertices of -signed distance (0: none)
   int max_penetration_frame = -1;  // -1: no vertex penetrates in any frame
@@ -71,6 +77,7 @@ struct ValidityFigures {
   int frames = 0;
   int intersection_stride = 1;
   double penetration_limit = 0.005;  // metres
+  double tear_stretch = 2;           // see ValidityOptions
   bool body_measured = false;
   int body_crossing_frames = 0;  // frames where two body parts intersect (see above; -1: not measured)
   ResolutionValidity lr, hr;

@@ -100,6 +100,14 @@ std::string fmt(double x) {
 
 }  // namespace
 
+GarmentMesh as_written_obj(const GarmentMesh& mesh) {
+  auto round_trip = [](double x) { return std::strtod(fmt(x).c_str(), nullptr); };
+  GarmentMesh m = mesh;
+  m.V = mesh.V.unaryExpr(round_trip);
+  m.UV = mesh.UV.unaryExpr(round_trip);
+  return m;
+}
+
 ObjData read_obj(const std::string& path) { return parse_obj(read_all(path), path); }
 
 ObjData parse_obj(const std::string& text, const std::string& path) {

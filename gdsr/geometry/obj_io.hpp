@@ -40,6 +40,9 @@ GarmentMesh garment_from_obj(const ObjData& obj, const std::string& what);
 // Writes via a temporary file in the same folder, then renames. %.9g precision.
 void write_obj(const std::string& path, const TriMesh& mesh);
 void write_obj(const std::string& path, const GarmentMesh& mesh);  // v, vt, f v/vt
+// The mesh as written and read back (coordinates and UVs at %.9g), to measure exactly what a
+// reader of the file will see.
+GarmentMesh as_written_obj(const GarmentMesh& mesh);
 
 // Writes `bytes` to `path` via path + ".tmp.<pid>" and a rename. Throws on any I/O error.
 void write_file_atomic(const std::string& path, const std::string& bytes);

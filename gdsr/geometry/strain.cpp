@@ -11,19 +11,32 @@
 
 namespace gdsr {
 
-StrainEnergies strain_energies(const GarmentMesh& g, const Points3& X) {
+namespace {
+
+void check_positions(const GarmentMesh& g, const Points3& X) {
   if (X.rows() != g.V.rows())
     gdsr::fail("strain",
                std::to_string(X.rows()) + " positions for a garment of " + std::to_string(g.V.rows()) + " vertices");
+}
+
+// The UV triangle of face f is degenerate (|det Dm| <= 1e-8 x longest UV edge^2, scale-free).
+bool degenerate_uv(const GarmentMesh& g, int f, Eigen::Matrix2d& Dm) {
+  const Vec2 u0 = g.UV.row(g.FUV(f, 0)), u1 = g.UV.row(g.FUV(f, 1)), u2 = g.UV.row(g.FUV(f, 2));
+  Dm.col(0) = u1 - u0;
+  Dm.col(1) = u2 - u0;
+  const double scale2 = std::max({Dm.col(0).squaredNorm(), Dm.col(1).squaredNorm(), (u2 - u1).squaredNorm()});
+  return !(std::abs(Dm.determinant()) > 1e-8 * scale2);
+}
+
+}  // namespace
+
+StrainEnergies strain_energies(const GarmentMesh& g, const Points3& X) {
+  check_positions(g, X);
   StrainEnergies s;
   int n = 0;
   for (int f = 0; f < g.F.rows(); ++f) {
-    const Vec2 u0 = g.UV.row(g.FUV(f, 0)), u1 = g.UV.row(g.FUV(f, 1)), u2 = g.UV.row(g.FUV(f, 2));
     Eigen::Matrix2d Dm;
-    Dm.col(0) = u1 - u0;
-    Dm.col(1) = u2 - u0;
-    const double scale2 = std::max({Dm.col(0).squaredNorm(), Dm.col(1).squaredNorm(), (u2 - u1).squaredNorm()});
-    if (!(std::abs(Dm.determinant()) > 1e-8 * scale2)) continue;
+    if (degenerate_uv(g, f, Dm)) continue;
     Eigen::Matrix<double, 3, 2> Ds;
     Ds.col(0) = X.row(g.F(f, 1)) - X.row(g.F(f, 0));
     Ds.col(1) = X.row(g.F(f, 2)) - X.row(g.F(f, 0));
@@ -40,6 +53,21 @@ StrainEnergies strain_energies(const GarmentMesh& g, const Points3& X) {
     s.E_uv /= n;
   }
   return s;
+}
+
+double max_edge_stretch(const GarmentMesh& g, const Points3& X) {
+  check_positions(g, X);
+  double worst = 0;
+  for (int f = 0; f < g.F.rows(); ++f) {
+    Eigen::Matrix2d Dm;
+    if (degenerate_uv(g, f, Dm)) continue;
+    for (int k = 0; k < 3; ++k) {
+      const int a = (k + 1) % 3;
+      const double rest = (g.UV.row(g.FUV(f, k)) - g.UV.row(g.FUV(f, a))).norm();
+      if (rest > 0) worst = std::max(worst, (X.row(g.F(f, k)) - X.row(g.F(f, a))).norm() / rest);
+    }
+  }
+  return worst;
 }
 
 }  // namespace gdsr

@@ -106,6 +106,7 @@ TEST_CASE("cli data: make a tiny dataset, check it and preview a frame") {
   CHECK(chk.out.find("garment skirt_short") != std::string::npos);
   // `data check` recomputes the figures `data make` stored: the same numbers.
   CHECK(chk.out.find("body: max penetration") != std::string::npos);
+  CHECK(chk.out.find("strain: longest edge / pattern") != std::string::npos);
   CHECK(chk.out.find("stored validity figures agree with the recomputed ones") != std::string::npos);
   if (chk.out.find("agree with the") == std::string::npos) MESSAGE("stdout: " << chk.out);
   const Run pv =

@@ -80,6 +80,10 @@ TEST_CASE("gdsr: validity figures of a stretched, lifted sheet over a rising box
   }
   CHECK(v.strain_ratio_u() == doctest::Approx(1.0));
   CHECK(std::isnan(v.strain_ratio_v()));  // LR has none: no ratio
+  for (const gdsr::ResolutionValidity* r : {&v.lr, &v.hr}) {
+    CHECK(r->max_edge_stretch == doctest::Approx(1.1).epsilon(1e-9));  // the edges along u
+    CHECK(r->torn_frames == 0);
+  }
   CHECK(v.agreement_mean == doctest::Approx(0.002).epsilon(1e-9));
   CHECK(v.agreement_max == doctest::Approx(0.002).epsilon(1e-9));
   CHECK(v.agreement_rest < 1e-12);
@@ -242,4 +246,43 @@ TEST_CASE("gdsr: validity wrinkles: HR ripples above LR upsampled / figures surv
   nlohmann::json broken = w.manifest.validity;
   broken["hr"].erase("strain");
   CHECK_THROWS_WITH_AS(gdsr::validity_from_json(broken), doctest::Contains("hr.strain"), gdsr::Error);
+}
+
+TEST_CASE("gdsr: validity counts the frames where a vertex is dragged out of the cloth") {
+  // Frame 2 of the HR pulls one inner vertex 0.15 m out of the sheet (HR edges 0.0375 m in the
+  // pattern, stretched 1.1x along u): its edges along u become sqrt(0.04125^2 + 0.15^2) long,
+  // 4.15x their pattern length.
+  gdsr::Dataset d = stretched_dataset({0.001, 0.001, 0.001, 0.001});
+  const int inner = 4 * 9 + 4;  // (4, 4) of the 9 x 9 HR grid vertices
+  REQUIRE(std::abs(d.hr.V(inner, 0) - 0.15) < 1e-9);
+  REQUIRE(std::abs(d.hr.V(inner, 1) - 0.15) < 1e-9);
+  d.hr_frames[2](inner, 2) += 0.15;
+  gdsr::ValidityOptions opt;
+  const gdsr::ValidityFigures v = gdsr::measure_validity(d, opt);
+  CHECK(v.hr.max_edge_stretch == doctest::Approx(std::hypot(0.04125, 0.15) / 0.0375).epsilon(1e-6));
+  CHECK(v.hr.max_edge_stretch_frame == 2);
+  CHECK(v.hr.torn_frames == 1);
+  CHECK(v.lr.torn_frames == 0);
+  // A higher threshold counts none; the table prints the figures.
+  opt.tear_stretch = 5;
+  CHECK(gdsr::measure_validity(d, opt).hr.torn_frames == 0);
+  opt.tear_stretch = 1;
+  CHECK_THROWS_WITH_AS(gdsr::measure_validity(d, opt), doctest::Contains("tear stretch"), gdsr::Error);
+  const std::string table = gdsr::validity_table(v);
+  CHECK(table.find("strain: frames with an edge > 2x") != std::string::npos);
+  CHECK(table.find("4.15x (f  2)") != std::string::npos);
+  // Survives the manifest; a manifest written before the figure existed reads -1 (not measured)
+  // and the table leaves the lines out.
+  const nlohmann::json j = gdsr::validity_to_json(v);
+  const gdsr::ValidityFigures back = gdsr::validity_from_json(j);
+  CHECK(back.hr.torn_frames == 1);
+  CHECK(back.hr.max_edge_stretch == v.hr.max_edge_stretch);
+  CHECK(back.tear_stretch == 2);
+  nlohmann::json old = j;
+  for (const char* res : {"lr", "hr"})
+    for (const char* k : {"max_edge_stretch", "max_edge_stretch_frame", "torn_frames"}) old[res]["strain"].erase(k);
+  old.erase("tear_stretch");
+  const gdsr::ValidityFigures o = gdsr::validity_from_json(old);
+  CHECK(o.hr.torn_frames == -1);
+  CHECK(gdsr::validity_table(o).find("frames with an edge") == std::string::npos);
 }

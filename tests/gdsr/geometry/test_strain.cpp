@@ -1,4 +1,5 @@
-// Appendix-B stretch/shear energies (gdsr/geometry/strain.hpp) against closed forms.
+// Appendix-B stretch/shear energies and the longest edge (gdsr/geometry/strain.hpp) against
+// closed forms.
 #include <doctest/doctest.h>
 
 #include "gdsr/geometry/strain.hpp"
@@ -30,4 +31,24 @@ TEST_CASE("strain energies: shear (w_u . w_v)^2 of a simple shear / degenerate U
   CHECK(std::isfinite(d.E_u));
   CHECK(d.E_uv == doctest::Approx(0.25));
   CHECK_THROWS_WITH(gdsr::strain_energies(g, s.topRows(3)), doctest::Contains("3 positions"));
+}
+
+TEST_CASE("strain: the longest edge over its pattern length finds one dragged-out vertex") {
+  // 3x3 quads over 0.2 m: edges a = 0.2 / 3 along u and v, diagonals a sqrt 2.
+  const gdsr::GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec(3, 3, 0.2, 0.2));
+  const double a = 0.2 / 3;
+  CHECK(gdsr::max_edge_stretch(g, g.V) == doctest::Approx(1).epsilon(1e-12));
+  gdsr::Points3 s = g.V;
+  s.col(0) *= 1.5;
+  CHECK(gdsr::max_edge_stretch(g, s) == doctest::Approx(1.5).epsilon(1e-12));
+  // Pull the inner vertex at (a, a) 3a out of the sheet: its edges along u and v become
+  // sqrt(a^2 + 9 a^2) = a sqrt 10 long, its diagonals sqrt(11 / 2) times theirs.
+  int inner = -1;
+  for (int v = 0; v < g.V.rows(); ++v)
+    if (std::abs(g.V(v, 0) - a) < 1e-9 && std::abs(g.V(v, 1) - a) < 1e-9) inner = v;
+  REQUIRE(inner >= 0);
+  gdsr::Points3 d = g.V;
+  d(inner, 2) += 3 * a;
+  CHECK(gdsr::max_edge_stretch(g, d) == doctest::Approx(std::sqrt(10.0)).epsilon(1e-12));
+  CHECK_THROWS_WITH(gdsr::max_edge_stretch(g, s.topRows(3)), doctest::Contains("3 positions"));
 }
