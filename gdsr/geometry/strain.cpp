@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -63,11 +64,12 @@ double max_edge_stretch(const GarmentMesh& g, const Points3& X) {
     if (degenerate_uv(g, f, Dm)) continue;
     for (int k = 0; k < 3; ++k) {
       const int a = (k + 1) % 3;
-      const double rest = (g.UV.row(g.FUV(f, k)) - g.UV.row(g.FUV(f, a))).norm();
-      if (rest > 0) worst = std::max(worst, (X.row(g.F(f, k)) - X.row(g.F(f, a))).norm() / rest);
+      const double rest = (g.UV.row(g.FUV(f, k)) - g.UV.row(g.FUV(f, a))).norm();  // > 0: not degenerate
+      worst = std::max(worst, (X.row(g.F(f, k)) - X.row(g.F(f, a))).norm() / rest);
     }
   }
-  return worst;
+  // std::max drops a NaN ratio; a non-finite position must not read as intact cloth.
+  return X.allFinite() ? worst : std::numeric_limits<double>::quiet_NaN();
 }
 
 }  // namespace gdsr

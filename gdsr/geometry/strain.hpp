@@ -24,7 +24,7 @@ StrainEnergies strain_energies(const GarmentMesh& g, const Points3& X);
 // that a contact dragged out of the garment: a few vertices that the means above hide (a
 // forearm pushed single 10 mm t-shirt vertices 60 cm along the arm, edges 6x, while the mean
 // E_u stayed below 0.01). Edges of the triangles strain_energies leaves out do not count; 0
-// for a garment without faces.
+// for a garment without faces, NaN when a position is not finite.
 double max_edge_stretch(const GarmentMesh& g, const Points3& X);
 
 }  // namespace gdsr

@@ -2,6 +2,9 @@
 // closed forms.
 #include <doctest/doctest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "gdsr/geometry/strain.hpp"
 #include "tests/support/data_fixtures.hpp"
 
@@ -50,5 +53,7 @@ TEST_CASE("strain: the longest edge over its pattern length finds one dragged-ou
   gdsr::Points3 d = g.V;
   d(inner, 2) += 3 * a;
   CHECK(gdsr::max_edge_stretch(g, d) == doctest::Approx(std::sqrt(10.0)).epsilon(1e-12));
+  d(inner, 0) = std::numeric_limits<double>::quiet_NaN();  // a NaN does not read as intact cloth
+  CHECK(std::isnan(gdsr::max_edge_stretch(g, d)));
   CHECK_THROWS_WITH(gdsr::max_edge_stretch(g, s.topRows(3)), doctest::Contains("3 positions"));
 }
