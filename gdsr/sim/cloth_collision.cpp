@@ -48,7 +48,8 @@ SurfaceHit SurfaceGrid::closest(const Vec3& x, const gdsr::Points3& V, double ra
   const Eigen::Vector3i a = ((x.array() - radius - origin_.array()) / cell_).floor().cast<int>();
   const Eigen::Vector3i b = ((x.array() + radius - origin_.array()) / cell_).floor().cast<int>();
   double best = radius * radius;
-  std::vector<int> cand;
+  thread_local std::vector<int> cand;  // reused: one allocation per thread, not per query
+  cand.clear();
   for (int i = a.x(); i <= b.x(); ++i)
     for (int j = a.y(); j <= b.y(); ++j)
       for (int k = a.z(); k <= b.z(); ++k) {
@@ -59,20 +60,24 @@ SurfaceHit SurfaceGrid::closest(const Vec3& x, const gdsr::Points3& V, double ra
   cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
   Vec3 nsum = Vec3::Zero();
   for (int f : cand) {
-    if (accept && !accept(f)) continue;
     const Vec3 p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
+    // A face whose box is farther than the best distance so far (with room for rounding) can
+    // neither win nor tie: skip the exact test (the result is the same, bit for bit; a third
+    // of the query's time on the 10 mm skirt).
+    const Vec3 gap = (p0.cwiseMin(p1).cwiseMin(p2) - x).cwiseMax(x - p0.cwiseMax(p1).cwiseMax(p2)).cwiseMax(0.0);
+    if (gap.squaredNorm() > best + 2e-14) continue;
+    if (accept && !accept(f)) continue;
     const Vec3 bc = gdsr::closest_point_on_triangle(x, p0, p1, p2).bary;
     const Vec3 q = bc.x() * p0 + bc.y() * p1 + bc.z() * p2;
     const double d2 = (x - q).squaredNorm();
-    const Vec3 n = (p1 - p0).cross(p2 - p0).normalized();
     if (d2 < best - 1e-14) {
       best = d2;
       hit.face = f;
       hit.bary = bc;
       hit.point = q;
-      nsum = n;
+      nsum = (p1 - p0).cross(p2 - p0).normalized();
     } else if (hit.face >= 0 && d2 <= best + 1e-14) {
-      nsum += n;  // shared edge/vertex: average the faces' normals
+      nsum += (p1 - p0).cross(p2 - p0).normalized();  // shared edge/vertex: average the faces' normals
     }
   }
   if (hit.face < 0) return hit;
