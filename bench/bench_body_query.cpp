@@ -1,13 +1,17 @@
 // Body queries against the 01_01 body: closest points (1k / 15k garment-like points near
-// the surface, and far points), the max_distance knob (time vs fraction of points left
+// the surface, and far points; Embree's BodyQuery and the cloth solver's SurfaceGrid, which
+// answers only within its search radius), the max_distance knob (time vs fraction of points left
 // without an answer), ray casts, per-frame update + commit (rebuild vs refit, and the query
 // speed each leaves behind), and load_body_sequence seconds per frame.
 #include "gdsr/body/body.hpp"
 #include "gdsr/body/body_query.hpp"
+#include "gdsr/sim/cloth_collision.hpp"
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <random>
+#include <vector>
 
 using namespace gdsr;
 
@@ -58,6 +62,29 @@ void BM_ClosestNear(benchmark::State& st) {
   st.counters["triangles"] = static_cast<double>(m.F.rows());
 }
 BENCHMARK(BM_ClosestNear)->Arg(1000)->Arg(15000)->UseRealTime()->Unit(benchmark::kMicrosecond);
+
+// The cloth solver's body grid (gdsr/sim/cloth_collision.hpp) as the solver uses it: built
+// over two consecutive frames, queried at their blend within thickness + contact radius
+// (0.034 m), one query per point, points in parallel. found: fraction of points with a face
+// within the radius (the near points reach 8 cm off the surface).
+void BM_SolverGridNear(benchmark::State& st) {
+  const TriMesh m0 = body().frame_mesh(100), m1 = body().frame_mesh(101);
+  sim::SurfaceGrid grid;
+  grid.build(m0.F, m0.V, m1.V, 0.05);
+  const Points3 mid = 0.5 * (m0.V + m1.V);
+  const Points3 P = near_points(m0, static_cast<int>(st.range(0)), 1);
+  const int n = static_cast<int>(P.rows());
+  std::vector<int> face(n);
+  for (auto _ : st) {
+#pragma omp parallel for schedule(dynamic, 256)
+    for (int i = 0; i < n; ++i) face[i] = grid.closest(P.row(i).transpose(), mid, 0.034).face;
+    benchmark::DoNotOptimize(face.data());
+  }
+  st.counters["points_per_s"] =
+      benchmark::Counter(static_cast<double>(st.iterations() * n), benchmark::Counter::kIsRate);
+  st.counters["found"] = static_cast<double>(std::count_if(face.begin(), face.end(), [](int f) { return f >= 0; })) / n;
+}
+BENCHMARK(BM_SolverGridNear)->Arg(1000)->Arg(15000)->UseRealTime()->Unit(benchmark::kMicrosecond);
 
 void BM_ClosestFar(benchmark::State& st) {
   const TriMesh m = body().frame_mesh(100);
