@@ -49,7 +49,8 @@ sim::SurfaceHit brute_force(const Vec3& x, const gdsr::Faces& F, const Points3& 
 
 TEST_CASE("cloth collision: the body grid finds the same closest point as every face, bit for bit") {
   // A mannequin moving 6 cm sideways and 3 cm up over the frame; queries at the middle of the
-  // motion, near the surface (inside and outside it, and on its vertices, where faces tie), with the solver's search radius and a filter that rejects every third face.
+  // motion, near the surface (inside and outside it, and on its vertices, where faces tie),
+  // with the solver's search radius and a filter that rejects every third face.
   const gdsr::TriMesh body = sim::make_mannequin(1.7);
   Points3 V1 = body.V;
   V1.col(0).array() += 0.06;
