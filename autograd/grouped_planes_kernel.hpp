@@ -7,7 +7,8 @@
 // has ~4.3 per triangle). These kernels put a matrix's contiguous index in the lanes and
 // broadcast the rows' values, so that every lane works whatever the row count:
 //   backward_x  dx[r][i] += sum_o g[r][o] conj(W[o][i])   lanes over i (W as stored);
-//   backward_w  dW[o][i] += sum_r g[r][o] conj(x[r][i])   lanes over i;
+//   backward_w  dW[o][i] += sum_r g[r][o] conj(x[r][i])   lanes over i (or = when the
+//               op has claimed a fresh dW: no zero fill and no read of dW);
 //   forward     y[r][o]  += sum_i x[r][i] W^T[i][o]       lanes over o, W transposed into
 //               scratch first (L x L register tiles).
 // Each group's weights are used by a handful of rows, so the op streams them from memory
@@ -220,7 +221,7 @@ template <class R> void forward(const std::complex<R>* x, const CView<R>& W, std
 // group's dW, prefetched for writing meanwhile, a share per block.
 template <class R> void backward_w(const std::complex<R>* g, const std::complex<R>* x, const View<R>& dW, int64_t n,
                                    int64_t in, int64_t out, Buffer<R>& xr, Buffer<R>& xi, Buffer<R>& nxi,
-                                   const View<R>* next = nullptr) {
+                                   const View<R>* next = nullptr, bool overwrite = false) {
   using namespace Eigen::internal;
   using P = Packet<R>;
   constexpr int L = kLanes<R>, O = 2, Q = 4;
@@ -239,7 +240,12 @@ template <class R> void backward_w(const std::complex<R>* g, const std::complex<
     P re[OC][QC], im[OC][QC];
     for (int j = 0; j < OC; ++j)
       for (int q = 0; q < QC; ++q)
-        re[j][q] = ploadu<P>(dW.re + (o + j) * in + i + q * L), im[j][q] = ploadu<P>(dW.im + (o + j) * in + i + q * L);
+        if (overwrite) {
+          re[j][q] = im[j][q] = pset1<P>(R(0));
+        } else {
+          re[j][q] = ploadu<P>(dW.re + (o + j) * in + i + q * L);
+          im[j][q] = ploadu<P>(dW.im + (o + j) * in + i + q * L);
+        }
     for (int64_t r = 0; r < n; ++r) {
       P ar[QC], ai[QC], an[QC];
       for (int q = 0; q < QC; ++q) {
@@ -281,8 +287,10 @@ template <class R> void backward_w(const std::complex<R>* g, const std::complex<
     for (int64_t oo = 0; oo < out; ++oo) {
       std::complex<R> acc(0);
       for (int64_t r = 0; r < n; ++r) acc += g[r * out + oo] * std::conj(x[r * in + k]);
-      dW.re[oo * in + k] += acc.real();
-      dW.im[oo * in + k] += acc.imag();
+      R& dr = dW.re[oo * in + k];
+      R& di = dW.im[oo * in + k];
+      dr = (overwrite ? R(0) : dr) + acc.real();
+      di = (overwrite ? R(0) : di) + acc.imag();
     }
 }
 

@@ -81,10 +81,12 @@ template <class R, class WF, class BF> void kernel_forward(const GroupPlan& p, i
 }
 
 // dx (or null) += g W^H per group; dweight(g) / dbias(g): views to add dW, db into (re ==
-// nullptr: not wanted).
+// nullptr: not wanted), or to write them into when overwrite (every group's, zeros for a
+// group without rows).
 template <class R, class WF, class DWF, class DBF>
 void kernel_backward(const GroupPlan& p, int64_t G, const std::complex<R>* px, const std::complex<R>* pgy,
-                     std::complex<R>* dx, int64_t in, int64_t out, WF weight, DWF dweight, DBF dbias) {
+                     std::complex<R>* dx, int64_t in, int64_t out, WF weight, DWF dweight, DBF dbias,
+                     bool overwrite = false) {
   const int64_t N = p.offset[G];
 #pragma omp parallel if (N * in * out > kParallelMin)
   {
@@ -92,6 +94,11 @@ void kernel_backward(const GroupPlan& p, int64_t G, const std::complex<R>* px, c
 #pragma omp for schedule(dynamic, 16)
     for (int64_t g = 0; g < G; ++g) {
       const int64_t b = p.offset[g], n = p.offset[g + 1] - b;
+      if (n == 0 && overwrite) {
+        const grouped_kernel::View<R> dw = dweight(g), db = dbias(g);
+        for (int64_t e = 0; dw.re && e < in * out; ++e) dw.re[e * dw.es] = dw.im[e * dw.es] = R(0);
+        for (int64_t o = 0; db.re && o < out; ++o) db.re[o * db.es] = db.im[o * db.es] = R(0);
+      }
       if (n == 0) continue;
       const std::complex<R>* gy = pgy + b * out;
       if (dx) {
@@ -105,10 +112,11 @@ void kernel_backward(const GroupPlan& p, int64_t G, const std::complex<R>* px, c
       if (dw.re && dw.es == 1) {
         const grouped_kernel::View<R> dw_next = g + 1 < G ? dweight(g + 1) : dw;
         grouped_planes_kernel::backward_w<R>(gy, px + b * in, dw, n, in, out, xr, xi, nxi,
-                                             g + 1 < G ? &dw_next : nullptr);
+                                             g + 1 < G ? &dw_next : nullptr, overwrite);
       } else if (dw.re)
         grouped_kernel::backward_w<R>(gy, px + b * in, dw, n, in, out, a, s);
       const grouped_kernel::View<R> db = dbias(g);
+      for (int64_t o = 0; db.re && overwrite && o < out; ++o) db.re[o * db.es] = db.im[o * db.es] = R(0);
       if (db.re)
         for (int64_t k = 0; k < n; ++k)
           for (int64_t o = 0; o < out; ++o) {
@@ -276,10 +284,20 @@ template <class R> Tensor<std::complex<R>> grouped_linear_planes(const Tensor<st
            // The kernels write re and im together: both planes get a gradient buffer (the
            // one nobody asked for is written and ignored).
            const bool gw = gre || gim;
+           // This layer's columns of both planes' gradients still unwritten (the first
+           // backward into fresh planes, as in every training step): written, not added.
+           ColumnRanges cols{{w_begin, w_begin + out * in}};
+           if (has_bias) cols.push_back({b_begin, b_begin + out});
+           const bool disjoint = !has_bias || b_begin + out <= w_begin || w_begin + out * in <= b_begin;
+           const bool overwrite =
+               gre && gim && disjoint && rn->grad_columns_unwritten(cols) && imn->grad_columns_unwritten(cols);
+           if (overwrite) rn->claim_grad_columns(cols), imn->claim_grad_columns(cols);
            std::vector<R> unused_re, unused_im;
            R* dre = nullptr;
            R* dim = nullptr;
-           if (gw) {
+           if (overwrite) {
+             dre = rn->grad.data(), dim = imn->grad.data();
+           } else if (gw) {
              if (gre)
                rn->ensure_grad(), dre = rn->grad.data();
              else
@@ -301,7 +319,8 @@ template <class R> Tensor<std::complex<R>> grouped_linear_planes(const Tensor<st
                },
                [&](int64_t g) {
                  return gw && has_bias ? V{dre + g * P + b_begin, dim + g * P + b_begin, 1} : V{nullptr, nullptr, 1};
-               });
+               },
+               overwrite);
          });
   return y;
 }

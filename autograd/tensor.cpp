@@ -1,5 +1,6 @@
 #include "autograd/tensor.hpp"
 
+#include <limits>
 #include <sstream>
 #include <unordered_set>
 
@@ -87,6 +88,7 @@ void backward_from(const std::shared_ptr<NodeBase>& root, bool retain_graph) {
   root->seed_grad_one();
   for (auto it = order.rbegin(); it != order.rend(); ++it) {
     NodeBase* n = *it;
+    n->settle_grad();  // every op that adds into n has run; columns nobody wrote become 0
     if (n->backward_fn) n->backward_fn();
   }
   if (!retain_graph) {
@@ -113,6 +115,51 @@ template <class T> void fill(Storage<T>& v, int64_t n, T x) {
 #pragma omp parallel for schedule(static)
   for (int64_t i = 0; i < n; ++i) p[i] = x;
 }
+bool g_poison_claimed_grads = false;
+
+template <class T> bool Node<T>::grad_columns_unwritten(const ColumnRanges& cols) const {
+  if (grad.empty()) return true;
+  for (const auto& [b, e] : cols) {
+    bool inside = false;
+    for (const auto& [ub, ue] : unwritten_columns) inside = inside || (ub <= b && e <= ue);
+    if (!inside) return false;
+  }
+  return true;
+}
+
+template <class T> void Node<T>::claim_grad_columns(const ColumnRanges& cols) {
+  check_2d("claim_grad_columns", shape);
+  if (!grad_columns_unwritten(cols)) throw Error("claim_grad_columns: the columns already hold a gradient");
+  if (grad.empty()) {
+    grad.resize(value.size());  // Storage leaves the elements unset
+    if (g_poison_claimed_grads) std::fill(grad.begin(), grad.end(), T(std::numeric_limits<real_t<T>>::quiet_NaN()));
+    unwritten_columns = {{0, shape[1]}};
+  }
+  for (const auto& [b, e] : cols) {
+    ColumnRanges rest;
+    for (const auto& [ub, ue] : unwritten_columns) {
+      if (ub < b) rest.push_back({ub, std::min(ue, b)});
+      if (e < ue) rest.push_back({std::max(ub, e), ue});
+    }
+    unwritten_columns = std::move(rest);
+  }
+}
+
+template <class T> void Node<T>::settle_grad() {
+  if (unwritten_columns.empty()) return;
+  const int64_t rows = shape[0], cols = shape[1];
+  T* g = grad.data();
+#pragma omp parallel for schedule(static) if (numel() > (int64_t(1) << 20))
+  for (int64_t r = 0; r < rows; ++r)
+    for (const auto& [b, e] : unwritten_columns) std::fill(g + r * cols + b, g + r * cols + e, T(0));
+  unwritten_columns.clear();
+}
+
+template struct Node<float>;
+template struct Node<double>;
+template struct Node<std::complex<float>>;
+template struct Node<std::complex<double>>;
+
 template void fill(Storage<float>&, int64_t, float);
 template void fill(Storage<double>&, int64_t, double);
 template void fill(Storage<std::complex<float>>&, int64_t, std::complex<float>);

@@ -96,21 +96,47 @@ struct NodeBase {
   bool freed = false;
   virtual void zero_grad() = 0;
   virtual void seed_grad_one() = 0;  // grad := 1 (scalar root)
+  virtual void settle_grad() = 0;    // see Node::settle_grad
   virtual int64_t numel() const = 0;
 };
+
+// Column ranges [begin, end) of a 2-D tensor, sorted and disjoint.
+using ColumnRanges = std::vector<std::pair<int64_t, int64_t>>;
 
 template <class T> struct Node final : NodeBase {
   Shape shape;
   Storage<T> value;
   Storage<T> grad;  // empty until something flows in; then same size as value
+  // Columns of grad that were allocated by claim_grad_columns and that nobody has written
+  // yet: their contents are undefined until settle_grad() zeroes them.
+  ColumnRanges unwritten_columns;
 
+  // Before adding into grad: allocates it zeroed, or zeroes its unwritten columns.
   void ensure_grad() {
-    if (grad.empty()) fill(grad, numel(), T(0));
+    if (grad.empty())
+      fill(grad, numel(), T(0));
+    else
+      settle_grad();
   }
-  void zero_grad() override { grad.clear(); }
-  void seed_grad_one() override { fill(grad, numel(), T(1)); }
+  // For an op that will WRITE, not add, every row of the given columns of this 2-D tensor's
+  // gradient (GDSR's field: each layer's block of the hyper-network's output planes). The
+  // op then needs neither a zero fill nor a read of the old values: a fresh gradient is ~3
+  // weight-sized passes over memory instead of 5. grad_columns_unwritten says whether all of
+  // `cols` are free (grad empty, or those columns still unwritten); claim_grad_columns
+  // (only then) allocates grad without zeroing on first use and marks `cols` written. The
+  // backward pass settles each node before its own backward runs and every leaf at the end.
+  bool grad_columns_unwritten(const ColumnRanges& cols) const;
+  void claim_grad_columns(const ColumnRanges& cols);
+  void settle_grad() override;  // zeroes the unwritten columns; then grad is a plain gradient
+  void zero_grad() override { grad.clear(), unwritten_columns.clear(); }
+  void seed_grad_one() override { fill(grad, numel(), T(1)), unwritten_columns.clear(); }
   int64_t numel() const override { return static_cast<int64_t>(value.size()); }
 };
+
+// Tests set this to fill every gradient that claim_grad_columns allocates with NaN, so that a
+// claimed column an op fails to write, or an unwritten one settle_grad misses, shows up
+// instead of reading as a lucky zero (large fresh blocks come from the OS already zeroed).
+extern bool g_poison_claimed_grads;
 
 // Run reverse mode from `root` (which must hold exactly one element). Leaves keep their
 // gradients; intermediates are released afterwards unless retain_graph is true. Throws

@@ -104,9 +104,10 @@ void BM_GroupedLinearComplex(benchmark::State& state) {
 
 // The same on the layout GDSR's field uses: weights and bias read in place from two real
 // planes (the hyper-network's output, grouped_linear_planes), rows sorted by group.
-// fresh_grads:1 zeroes the gradients every iteration (allocating and filling 77 MB of weight
-// gradients, as the field's planes get in every training step); fresh_grads:0 adds into the
-// existing ones (the op alone, like the dense GEMM yardstick, which writes its dW afresh).
+// fresh_grads:1 drops the gradients every iteration, as the field's planes are fresh in every
+// training step: the op claims its columns and writes dW without a zero fill or a read of the
+// old values (Node::claim_grad_columns), as the dense GEMM yardstick writes its dW.
+// fresh_grads:0 adds into the existing 77 MB of gradients (read, add, write back).
 void BM_GroupedLinearPlanes(benchmark::State& state) {
   const bool fresh = state.range(0) != 0;
   using C = std::complex<float>;

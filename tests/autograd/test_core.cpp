@@ -156,3 +156,37 @@ TEST_CASE("core: outputs left unset at allocation are written everywhere (recycl
   MESSAGE(reused << " of 5 outputs landed in the freed NaN memory");
   CHECK(reused >= 3);  // the test is only meaningful if the allocator hands that memory back
 }
+
+// Columns claimed for writing are the op's to fill; the rest of a claimed gradient is zeroed
+// before anything reads it (Node::settle_grad), and later adders see a plain gradient.
+TEST_CASE("core: gradient columns claimed for writing, the rest zeroed when settled") {
+  const PoisonClaimedGrads poison;
+  ag::Node<double> n;
+  n.shape = {3, 10};
+  n.value.assign(30, 1.0);
+  const ag::ColumnRanges a{{2, 5}, {7, 8}};
+  CHECK(n.grad_columns_unwritten(a));
+  n.claim_grad_columns(a);
+  CHECK(n.unwritten_columns == ag::ColumnRanges{{0, 2}, {5, 7}, {8, 10}});
+  CHECK(std::isnan(n.grad[0]));  // poisoned: not yet zeroed
+  for (int64_t r = 0; r < 3; ++r)
+    for (const auto& [b, e] : a)
+      for (int64_t c = b; c < e; ++c) n.grad[r * 10 + c] = 10.0 * r + c;
+  CHECK_FALSE(n.grad_columns_unwritten({{4, 6}}));  // column 4 is written
+  CHECK(n.grad_columns_unwritten({{5, 7}, {9, 10}}));
+  CHECK_THROWS_WITH_AS(n.claim_grad_columns({{1, 3}}), doctest::Contains("already"), ag::Error);
+  n.claim_grad_columns({{5, 7}});
+  for (int64_t r = 0; r < 3; ++r) n.grad[r * 10 + 5] = n.grad[r * 10 + 6] = -1.0;
+  n.ensure_grad();  // an op about to add: the unwritten columns 0, 1, 8, 9 become zero
+  CHECK(n.unwritten_columns.empty());
+  for (int64_t r = 0; r < 3; ++r)
+    for (int64_t c = 0; c < 10; ++c) {
+      CAPTURE(r);
+      CAPTURE(c);
+      const double want = (c >= 2 && c < 5) || c == 7 ? 10.0 * r + c : (c == 5 || c == 6) ? -1.0 : 0.0;
+      CHECK(n.grad[r * 10 + c] == want);
+    }
+  CHECK_FALSE(n.grad_columns_unwritten({{0, 1}}));  // a settled gradient holds every column
+  n.zero_grad();
+  CHECK(n.grad_columns_unwritten({{0, 10}}));
+}

@@ -174,6 +174,7 @@ TEST_CASE("grouped_linear: errors name the op and the shapes") {
 }
 
 TEST_CASE("grouped_linear_planes: gradient, and equal to grouped_linear on sliced planes") {
+  const PoisonClaimedGrads poison;  // columns 0-1 and the last 4 are nobody's: they must read 0
   const int64_t G = 4, in = 5, out = 3, N = 17, P = 2 + in * out + out + 4;  // weights at 2, bias after
   const int64_t wb = 2, bb = 2 + in * out;
   const Tensord xr = randn({N, in}, 51), xi = randn({N, in}, 52), re = randn({G, P}, 53), im = randn({G, P}, 54);
@@ -229,8 +230,11 @@ template <class R> double planes_vs_interleaved(int64_t in, int64_t out, const a
   auto compare = [&](const auto& a, const auto& b) {
     REQUIRE(a.size() == b.size());
     double d = 0, m = 0;
-    for (size_t k = 0; k < a.size(); ++k)
-      d = std::max(d, double(std::abs(a[k] - b[k]))), m = std::max(m, double(std::abs(b[k])));
+    for (size_t k = 0; k < a.size(); ++k) {
+      const double e = std::abs(a[k] - b[k]);
+      d = std::isnan(e) ? HUGE_VAL : std::max(d, e);  // std::max would drop a NaN
+      m = std::max(m, double(std::abs(b[k])));
+    }
     worst = std::max(worst, d / m);
   };
   compare(ya.values(), yb.values());
@@ -242,6 +246,7 @@ template <class R> double planes_vs_interleaved(int64_t in, int64_t out, const a
 }  // namespace
 
 TEST_CASE("grouped_linear_planes: the planes kernels match the interleaved ones at the field's size and ragged sizes") {
+  const PoisonClaimedGrads poison;  // empty groups must get a zero dW, not what was in memory
   // Group sizes 0..13 (empty groups, single rows, more rows than one register block of 6).
   const int64_t G = 40;
   ag::Index g;
@@ -252,5 +257,45 @@ TEST_CASE("grouped_linear_planes: the planes kernels match the interleaved ones 
     CAPTURE(out);
     CHECK(planes_vs_interleaved<double>(in, out, g, G) < 1e-13);
     CHECK(planes_vs_interleaved<float>(in, out, g, G) < 1e-5);  // float rounding, summed in another order
+  }
+}
+
+// GDSR's field: several layers read one pair of planes, each its own columns, and a real layer
+// reads another block through slice_cols. The first backward into fresh planes writes each
+// layer's columns (claim_grad_columns); slice_cols adds; columns nobody reads come out 0; a
+// second backward adds to all of it.
+TEST_CASE("grouped_linear_planes: layers sharing planes write their columns, then add on a second backward") {
+  const PoisonClaimedGrads poison;
+  const int64_t G = 5, f = 4, P = f + 2 * (f * f + f) + 2;  // [real block f][layer 1][layer 2][unused 2]
+  const int64_t w1 = f, b1 = w1 + f * f, w2 = b1 + f, b2 = w2 + f * f;
+  ag::Index g{0, 0, 1, 3, 3, 3, 4};  // group 2 has no rows
+  const int64_t N = static_cast<int64_t>(g.size());
+  auto f_of = [&](const std::vector<Tensord>& v) {
+    // As in the field, the real block feeds the first complex layer, so its backward runs last.
+    const Tensord block = ag::index_select_rows(ag::slice_cols(v[1], 0, f), g);  // re only
+    const Tensorcd h1 = ag::grouped_linear_planes(cplx(ag::mul(v[0], block), v[3]), v[1], v[2], w1, b1, g, f);
+    const Tensorcd h2 = ag::grouped_linear_planes(h1, v[1], v[2], w2, -1, g, f);
+    return ag::sum(ag::add(ag::real(h2), ag::mul_scalar(ag::imag(h2), 0.3)));
+  };
+  const Tensord x = randn({N, f}, 71), re = randn({G, P}, 72), im = randn({G, P}, 73), s = randn({N, f}, 74);
+  // Against finite differences, and the planes' gradient against the same model built on copies
+  // that an earlier backward has already given a gradient (every op adds there).
+  check_grad("planes shared by two layers and a slice", kTol, [&](auto& v) { return f_of(v); }, {x, re, im, s});
+  auto leaf = [](const Tensord& t) { return t.detach().set_requires_grad(true); };
+  std::vector<Tensord> a{leaf(x), leaf(re), leaf(im), leaf(s)};
+  f_of(a).backward();
+  const ag::Storage<double> re1 = a[1].grad(), im1 = a[2].grad();
+  for (const ag::Storage<double>* d : {&re1, &im1}) {
+    CHECK(all_finite(*d));
+    for (int64_t r = 0; r < G; ++r)
+      for (int64_t c = P - 2; c < P; ++c) CHECK((*d)[r * P + c] == 0.0);  // unused columns
+    for (int64_t c = w1; c < b2; ++c) CHECK((*d)[2 * P + c] == 0.0);      // the empty group
+  }
+  for (int64_t c = 0; c < f; ++c) CHECK(im1[c] == 0.0);  // the real block's im part is unused
+  // Second pass: the planes hold a gradient now, so both layers add.
+  f_of(a).backward();
+  for (size_t k = 0; k < re1.size(); ++k) {
+    CHECK(a[1].grad()[k] == doctest::Approx(2 * re1[k]).epsilon(1e-12));
+    CHECK(a[2].grad()[k] == doctest::Approx(2 * im1[k]).epsilon(1e-12));
   }
 }

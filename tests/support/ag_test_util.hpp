@@ -96,4 +96,15 @@ inline ag::GradCheckOptions step_for_multilinear() {
 inline ag::Tensorcd cplx(const Tensord& re, const Tensord& im) { return ag::complex_from(re, im); }
 inline Tensord split(const ag::Tensorcd& z) { return ag::concat_cols<double>({ag::real(z), ag::imag(z)}); }
 
+// While alive, every gradient an op claims to write (Node::claim_grad_columns) starts as NaN,
+// so a column it claims but misses, or one that nobody writes and backward does not zero,
+// turns a gradient check red instead of reading as memory that happened to be zero.
+struct PoisonClaimedGrads {
+  bool before = ag::g_poison_claimed_grads;
+  PoisonClaimedGrads() { ag::g_poison_claimed_grads = true; }
+  ~PoisonClaimedGrads() { ag::g_poison_claimed_grads = before; }
+  PoisonClaimedGrads(const PoisonClaimedGrads&) = delete;
+  PoisonClaimedGrads& operator=(const PoisonClaimedGrads&) = delete;
+};
+
 }  // namespace agt

@@ -8,6 +8,7 @@
 #include "autograd/autograd.hpp"
 #include "gdsr/model/gdsr_model.hpp"
 #include "gdsr/model/model_config.hpp"
+#include "tests/support/ag_test_util.hpp"
 #include "tests/support/body_contact.hpp"
 #include "tests/support/model_test_util.hpp"
 
@@ -162,6 +163,7 @@ void check_whole_model(double s, Units units) {
 }  // namespace
 
 TEST_CASE("model gradcheck: whole GDSR model, tiny preset, float64") {
+  const agt::PoisonClaimedGrads poison;  // the field's planes: each layer writes its columns
   // Parameters and C; the body-interaction features are off here (see check_whole_model).
   check_whole_model(1.0, Units::converted);
 }
