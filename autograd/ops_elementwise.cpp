@@ -84,25 +84,37 @@ Tensor<T> binary_op(const char* name, const Tensor<T>& a, const Tensor<T>& b, F 
     const T* av = an->value.data();
     const T* bv = bn->value.data();
     const T* ov = on->value.data();
+    const int64_t n = bc.R * bc.C;
+    if (bc.same) {
+      // a's part, then b's (a then b also when they are one tensor, as in mul(x, x)): each
+      // writes a first gradient, or adds to one that is there.
+      auto part = [&](Node<T>* pn, auto d) {
+        if (!pn->requires_grad) return;
+        const bool first = pn->claim_whole_grad();
+        T* gp = pn->grad.data();
+        if (first) {
+#pragma omp parallel for firstprivate(d) if (n > kParallelMin)
+          for (int64_t i = 0; i < n; ++i) gp[i] = g[i] * cj(d(av[i], bv[i], ov[i]));
+        } else {
+#pragma omp parallel for firstprivate(d) if (n > kParallelMin)
+          for (int64_t i = 0; i < n; ++i) gp[i] += g[i] * cj(d(av[i], bv[i], ov[i]));
+        }
+      };
+      part(an, da);
+      part(bn, db);
+      return;
+    }
     if (an->requires_grad) an->ensure_grad();
     if (bn->requires_grad) bn->ensure_grad();
     T* ga = an->requires_grad ? an->grad.data() : nullptr;
     T* gb = bn->requires_grad ? bn->grad.data() : nullptr;
-    const int64_t n = bc.R * bc.C;
-    if (bc.same) {
-#pragma omp parallel for if (n > kParallelMin)
-      for (int64_t i = 0; i < n; ++i) {
-        if (ga) ga[i] += g[i] * cj(da(av[i], bv[i], ov[i]));
-        if (gb) gb[i] += g[i] * cj(db(av[i], bv[i], ov[i]));
+    // Broadcast operands accumulate: serial.
+    for (int64_t r = 0; r < bc.R; ++r)
+      for (int64_t c = 0; c < bc.C; ++c) {
+        const int64_t i = r * bc.C + c, ia = bc.a.at(r, c), ib = bc.b.at(r, c);
+        if (ga) ga[ia] += g[i] * cj(da(av[ia], bv[ib], ov[i]));
+        if (gb) gb[ib] += g[i] * cj(db(av[ia], bv[ib], ov[i]));
       }
-    } else {  // broadcast operands accumulate: serial
-      for (int64_t r = 0; r < bc.R; ++r)
-        for (int64_t c = 0; c < bc.C; ++c) {
-          const int64_t i = r * bc.C + c, ia = bc.a.at(r, c), ib = bc.b.at(r, c);
-          if (ga) ga[ia] += g[i] * cj(da(av[ia], bv[ib], ov[i]));
-          if (gb) gb[ib] += g[i] * cj(db(av[ia], bv[ib], ov[i]));
-        }
-    }
   });
   return out;
 }
@@ -117,15 +129,20 @@ template <class T, class F, class DF> Tensor<T> unary_op(const Tensor<T>& x, F f
 #pragma omp parallel for firstprivate(f) if (n > kParallelMin)
   for (int64_t i = 0; i < n; ++i) ov[i] = f(xv[i]);
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), df] {
-    xn->ensure_grad();
+    const bool first = xn->claim_whole_grad();  // write the first gradient, add later ones
     const int64_t n = static_cast<int64_t>(on->value.size());
     const T* g = on->grad.data();
     const T* xv = xn->value.data();
     const T* ov = on->value.data();
     T* gx = xn->grad.data();
     const DF d = df;
+    if (first) {
 #pragma omp parallel for firstprivate(d) if (n > kParallelMin)
-    for (int64_t i = 0; i < n; ++i) gx[i] += g[i] * cj(d(xv[i], ov[i]));
+      for (int64_t i = 0; i < n; ++i) gx[i] = g[i] * cj(d(xv[i], ov[i]));
+    } else {
+#pragma omp parallel for firstprivate(d) if (n > kParallelMin)
+      for (int64_t i = 0; i < n; ++i) gx[i] += g[i] * cj(d(xv[i], ov[i]));
+    }
   });
   return out;
 }

@@ -61,19 +61,30 @@ void check_linear(const char* op, const Tensor<T>& x, const Tensor<T>& weight, c
 template <class T> void linear_backward(Node<T>& xn, Node<T>& wn, Node<T>* bn, const T* g) {
   const int64_t N = xn.shape[0], I = xn.shape[1], O = wn.shape[0];
   ConstMatMap<T> X(xn.value.data(), N, I), W(wn.value.data(), O, I), G(g, N, O);
+  // A first gradient is written tile by tile (each tile zeroed in cache by the product),
+  // later ones added: no separate zero-filling pass over dX or dW.
   if (xn.requires_grad) {
-    xn.ensure_grad();
+    const bool first = xn.claim_whole_grad();
     MatMap<T> dX(xn.grad.data(), N, I);
     tiles(N, I, O, [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
-      dX.block(r0, c0, r1 - r0, c1 - c0).noalias() += G.middleRows(r0, r1 - r0) * W.middleCols(c0, c1 - c0).conjugate();
+      auto tile = dX.block(r0, c0, r1 - r0, c1 - c0);
+      const auto prod = G.middleRows(r0, r1 - r0) * W.middleCols(c0, c1 - c0).conjugate();
+      if (first)
+        tile.noalias() = prod;
+      else
+        tile.noalias() += prod;
     });
   }
   if (wn.requires_grad) {
-    wn.ensure_grad();
+    const bool first = wn.claim_whole_grad();
     MatMap<T> dW(wn.grad.data(), O, I);
     tiles(O, I, N, [&](int64_t r0, int64_t r1, int64_t c0, int64_t c1) {
-      dW.block(r0, c0, r1 - r0, c1 - c0).noalias() +=
-          G.middleCols(r0, r1 - r0).transpose() * X.middleCols(c0, c1 - c0).conjugate();
+      auto tile = dW.block(r0, c0, r1 - r0, c1 - c0);
+      const auto prod = G.middleCols(r0, r1 - r0).transpose() * X.middleCols(c0, c1 - c0).conjugate();
+      if (first)
+        tile.noalias() = prod;
+      else
+        tile.noalias() += prod;
     });
   }
   if (bn && bn->requires_grad) {

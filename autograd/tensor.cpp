@@ -145,6 +145,16 @@ template <class T> void Node<T>::claim_grad_columns(const ColumnRanges& cols) {
   }
 }
 
+template <class T> bool Node<T>::claim_whole_grad() {
+  if (!grad.empty()) {
+    settle_grad();
+    return false;
+  }
+  grad.resize(value.size());  // Storage leaves the elements unset
+  if (g_poison_claimed_grads) std::fill(grad.begin(), grad.end(), T(std::numeric_limits<real_t<T>>::quiet_NaN()));
+  return true;
+}
+
 template <class T> void Node<T>::settle_grad() {
   if (unwritten_columns.empty()) return;
   const int64_t rows = shape[0], cols = shape[1];

@@ -127,6 +127,10 @@ template <class T> struct Node final : NodeBase {
   // backward pass settles each node before its own backward runs and every leaf at the end.
   bool grad_columns_unwritten(const ColumnRanges& cols) const;
   void claim_grad_columns(const ColumnRanges& cols);
+  // The same for an op about to give every element of the gradient a value: true if nothing
+  // has flowed in yet (grad is then allocated unset and the op writes it), false after
+  // ensure_grad (the op adds). Saves the zero fill and a read of every first gradient.
+  bool claim_whole_grad();
   void settle_grad() override;  // zeroes the unwritten columns; then grad is a plain gradient
   void zero_grad() override { grad.clear(), unwritten_columns.clear(); }
   void seed_grad_one() override { fill(grad, numel(), T(1)), unwritten_columns.clear(); }

@@ -160,7 +160,6 @@ TEST_CASE("core: outputs left unset at allocation are written everywhere (recycl
 // Columns claimed for writing are the op's to fill; the rest of a claimed gradient is zeroed
 // before anything reads it (Node::settle_grad), and later adders see a plain gradient.
 TEST_CASE("core: gradient columns claimed for writing, the rest zeroed when settled") {
-  const PoisonClaimedGrads poison;
   ag::Node<double> n;
   n.shape = {3, 10};
   n.value.assign(30, 1.0);
@@ -189,4 +188,34 @@ TEST_CASE("core: gradient columns claimed for writing, the rest zeroed when sett
   CHECK_FALSE(n.grad_columns_unwritten({{0, 1}}));  // a settled gradient holds every column
   n.zero_grad();
   CHECK(n.grad_columns_unwritten({{0, 10}}));
+}
+
+// The first gradient into a tensor is written, later ones added (Node::claim_whole_grad):
+// mul(x, x) writes a's part and adds b's into the same buffer; x also feeds tanh and a linear
+// layer, and a second backward adds to all of it. Claimed buffers start as NaN here.
+TEST_CASE("core: first gradients written, later ones added, also when both operands are one tensor") {
+  Tensord x = randn({6, 4}, 11), w = randn({3, 4}, 12);
+  x.set_requires_grad(true);
+  w.set_requires_grad(true);
+  auto loss = [&] {
+    return ag::add(ag::add(ag::sum(ag::mul(x, x)), ag::sum(ag::tanh(x))), ag::sum(ag::linear(x, w, Tensord())));
+  };
+  loss().backward();
+  for (int pass = 1; pass <= 2; ++pass) {
+    CAPTURE(pass);
+    for (int64_t r = 0; r < 6; ++r)
+      for (int64_t c = 0; c < 4; ++c) {
+        const double v = x.at(r, c), t = std::tanh(v);
+        double want = 2 * v + (1 - t * t);
+        for (int64_t o = 0; o < 3; ++o) want += w.at(o, c);
+        CHECK(x.grad()[r * 4 + c] == doctest::Approx(pass * want).epsilon(1e-12));
+      }
+    for (int64_t o = 0; o < 3; ++o)
+      for (int64_t c = 0; c < 4; ++c) {
+        double want = 0;
+        for (int64_t r = 0; r < 6; ++r) want += x.at(r, c);
+        CHECK(w.grad()[o * 4 + c] == doctest::Approx(pass * want).epsilon(1e-12));
+      }
+    if (pass == 1) loss().backward();
+  }
 }

@@ -174,7 +174,6 @@ TEST_CASE("grouped_linear: errors name the op and the shapes") {
 }
 
 TEST_CASE("grouped_linear_planes: gradient, and equal to grouped_linear on sliced planes") {
-  const PoisonClaimedGrads poison;  // columns 0-1 and the last 4 are nobody's: they must read 0
   const int64_t G = 4, in = 5, out = 3, N = 17, P = 2 + in * out + out + 4;  // weights at 2, bias after
   const int64_t wb = 2, bb = 2 + in * out;
   const Tensord xr = randn({N, in}, 51), xi = randn({N, in}, 52), re = randn({G, P}, 53), im = randn({G, P}, 54);
@@ -246,7 +245,6 @@ template <class R> double planes_vs_interleaved(int64_t in, int64_t out, const a
 }  // namespace
 
 TEST_CASE("grouped_linear_planes: the planes kernels match the interleaved ones at the field's size and ragged sizes") {
-  const PoisonClaimedGrads poison;  // empty groups must get a zero dW, not what was in memory
   // Group sizes 0..13 (empty groups, single rows, more rows than one register block of 6).
   const int64_t G = 40;
   ag::Index g;
@@ -265,7 +263,6 @@ TEST_CASE("grouped_linear_planes: the planes kernels match the interleaved ones 
 // layer's columns (claim_grad_columns); slice_cols adds; columns nobody reads come out 0; a
 // second backward adds to all of it.
 TEST_CASE("grouped_linear_planes: layers sharing planes write their columns, then add on a second backward") {
-  const PoisonClaimedGrads poison;
   const int64_t G = 5, f = 4, P = f + 2 * (f * f + f) + 2;  // [real block f][layer 1][layer 2][unused 2]
   const int64_t w1 = f, b1 = w1 + f * f, w2 = b1 + f, b2 = w2 + f * f;
   ag::Index g{0, 0, 1, 3, 3, 3, 4};  // group 2 has no rows

@@ -96,15 +96,10 @@ inline ag::GradCheckOptions step_for_multilinear() {
 inline ag::Tensorcd cplx(const Tensord& re, const Tensord& im) { return ag::complex_from(re, im); }
 inline Tensord split(const ag::Tensorcd& z) { return ag::concat_cols<double>({ag::real(z), ag::imag(z)}); }
 
-// While alive, every gradient an op claims to write (Node::claim_grad_columns) starts as NaN,
-// so a column it claims but misses, or one that nobody writes and backward does not zero,
-// turns a gradient check red instead of reading as memory that happened to be zero.
-struct PoisonClaimedGrads {
-  bool before = ag::g_poison_claimed_grads;
-  PoisonClaimedGrads() { ag::g_poison_claimed_grads = true; }
-  ~PoisonClaimedGrads() { ag::g_poison_claimed_grads = before; }
-  PoisonClaimedGrads(const PoisonClaimedGrads&) = delete;
-  PoisonClaimedGrads& operator=(const PoisonClaimedGrads&) = delete;
-};
+// Every test built with this header runs with poisoned gradient claims: a gradient that an
+// op claims to write (Node::claim_whole_grad, claim_grad_columns) starts as NaN, so an
+// element it misses, or a column nobody writes that backward fails to zero, turns a check
+// red instead of reading as memory that happened to be zero.
+inline const bool kPoisonClaimedGrads = (ag::g_poison_claimed_grads = true);
 
 }  // namespace agt

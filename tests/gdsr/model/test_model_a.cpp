@@ -58,7 +58,6 @@ TEST_CASE("model A: field parameters of a triangle are the same asked alone or w
 // The whole-model gradient check asks for fewer triangles than vertices; this one checks the
 // per-vertex path (every triangle of the grid), with respect to z_detail.
 TEST_CASE("model A: float64 gradient check with every triangle asked for") {
-  const agt::PoisonClaimedGrads poison;  // the field's planes: each layer writes its columns
   const Setup s(4, 6, 1.3);
   const auto r = ag::gradcheck(
       [&](const std::vector<ag::Tensord>& in) {

@@ -163,7 +163,6 @@ void check_whole_model(double s, Units units) {
 }  // namespace
 
 TEST_CASE("model gradcheck: whole GDSR model, tiny preset, float64") {
-  const agt::PoisonClaimedGrads poison;  // the field's planes: each layer writes its columns
   // Parameters and C; the body-interaction features are off here (see check_whole_model).
   check_whole_model(1.0, Units::converted);
 }
