@@ -90,7 +90,7 @@ struct NodeBase {
   virtual ~NodeBase() = default;
   bool requires_grad = false;
   std::vector<std::shared_ptr<NodeBase>> parents;
-  std::function<void()> backward_fn;  // reads this node's grad, adds into parents' grads
+  std::function<void()> backward_fn;  // reads this node's grad, adds (or first writes) into parents'
   // Set when a backward() without retain_graph released this intermediate's history: a later
   // backward() that reaches it throws instead of treating it as a leaf.
   bool freed = false;
