@@ -115,6 +115,8 @@ template <class T> void fill(Storage<T>& v, int64_t n, T x) {
 #pragma omp parallel for schedule(static)
   for (int64_t i = 0; i < n; ++i) p[i] = x;
 }
+
+// ---- gradient claims (see Node) -------------------------------------------------------------
 bool g_poison_claimed_grads = false;
 
 template <class T> bool Node<T>::grad_columns_unwritten(const ColumnRanges& cols) const {

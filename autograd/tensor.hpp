@@ -124,7 +124,7 @@ template <class T> struct Node final : NodeBase {
   // weight-sized passes over memory instead of 5. grad_columns_unwritten says whether all of
   // `cols` are free (grad empty, or those columns still unwritten); claim_grad_columns
   // (only then) allocates grad without zeroing on first use and marks `cols` written. The
-  // backward pass settles each node before its own backward runs and every leaf at the end.
+  // backward pass settles each node (leaves too) once every op that feeds its gradient ran.
   bool grad_columns_unwritten(const ColumnRanges& cols) const;
   void claim_grad_columns(const ColumnRanges& cols);
   // The same for an op about to give every element of the gradient a value: true if nothing
@@ -137,9 +137,10 @@ template <class T> struct Node final : NodeBase {
   int64_t numel() const override { return static_cast<int64_t>(value.size()); }
 };
 
-// Tests set this to fill every gradient that claim_grad_columns allocates with NaN, so that a
-// claimed column an op fails to write, or an unwritten one settle_grad misses, shows up
-// instead of reading as a lucky zero (large fresh blocks come from the OS already zeroed).
+// Tests set this to fill every gradient that claim_whole_grad or claim_grad_columns allocates
+// with NaN, so that an element an op fails to write, or an unwritten column settle_grad
+// misses, shows up instead of reading as a lucky zero (large fresh blocks come from the OS
+// already zeroed).
 extern bool g_poison_claimed_grads;
 
 // Run reverse mode from `root` (which must hold exactly one element). Leaves keep their
