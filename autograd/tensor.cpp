@@ -119,6 +119,14 @@ template <class T> void fill(Storage<T>& v, int64_t n, T x) {
 // ---- gradient claims (see Node) -------------------------------------------------------------
 bool g_poison_claimed_grads = false;
 
+namespace {
+// A claimed gradient buffer: elements unset (NaN when tests poison claims).
+template <class T> void allocate_unset(Storage<T>& grad, size_t n) {
+  grad.resize(n);
+  if (g_poison_claimed_grads) std::fill(grad.begin(), grad.end(), T(std::numeric_limits<real_t<T>>::quiet_NaN()));
+}
+}  // namespace
+
 template <class T> bool Node<T>::grad_columns_unwritten(const ColumnRanges& cols) const {
   if (grad.empty()) return true;
   for (const auto& [b, e] : cols) {
@@ -133,8 +141,7 @@ template <class T> void Node<T>::claim_grad_columns(const ColumnRanges& cols) {
   check_2d("claim_grad_columns", shape);
   if (!grad_columns_unwritten(cols)) throw Error("claim_grad_columns: the columns already hold a gradient");
   if (grad.empty()) {
-    grad.resize(value.size());  // Storage leaves the elements unset
-    if (g_poison_claimed_grads) std::fill(grad.begin(), grad.end(), T(std::numeric_limits<real_t<T>>::quiet_NaN()));
+    allocate_unset(grad, value.size());
     unwritten_columns = {{0, shape[1]}};
   }
   for (const auto& [b, e] : cols) {
@@ -152,8 +159,7 @@ template <class T> bool Node<T>::claim_whole_grad() {
     settle_grad();
     return false;
   }
-  grad.resize(value.size());  // Storage leaves the elements unset
-  if (g_poison_claimed_grads) std::fill(grad.begin(), grad.end(), T(std::numeric_limits<real_t<T>>::quiet_NaN()));
+  allocate_unset(grad, value.size());
   return true;
 }
 
