@@ -51,6 +51,11 @@ std::vector<Case> cases() {
                {{4, 3}, {4, 2}}});
   c.push_back({"index_select_rows", [](V x) { return index_select_rows(x[0], {3, 0, 0, 2}); }, {{4, 3}}});
   c.push_back({"scatter_add_rows", [](V x) { return scatter_add_rows(x[0], {1, 0, 1, 3}, 5); }, {{4, 3}}});
+  c.push_back({"add_gathered_rows",
+               [](V x) {
+                 return add_gathered_rows(x[0], x[1], {2, 0, 2, 1, 0}, x[2], {0, 0, 1, 3, 2});
+               },
+               {{5, 3}, {3, 3}, {4, 3}}});
   c.push_back({"scatter_mean_rows", [](V x) { return scatter_mean_rows(x[0], {1, 0, 1, 3}, 5); }, {{4, 3}}});
   c.push_back({"interpolate_rows",
                [](V x) {

@@ -62,7 +62,9 @@ Broadcast broadcast(const char* op, const Shape& sa, const Shape& sb) {
 
 // f(a, b) -> value; da(a, b, out) and db(a, b, out) -> local partial derivatives. For complex
 // (holomorphic) ops the incoming gradient is multiplied by the conjugate derivative.
-template <class T, class F, class DA, class DB>
+// kAPasses / kBPasses: da / db is 1 everywhere (add, sub's a), so that operand's gradient is
+// the output's, and it may take over the output's buffer (Node::take_grad) instead of a copy.
+template <class T, bool kAPasses = false, bool kBPasses = false, class F, class DA, class DB>
 Tensor<T> binary_op(const char* name, const Tensor<T>& a, const Tensor<T>& b, F f, DA da, DB db) {
   const Broadcast bc = broadcast(name, a.shape(), b.shape());
   Tensor<T> out = new_output_overwritten<T>(bc.out_shape);  // every element written below
@@ -100,6 +102,18 @@ Tensor<T> binary_op(const char* name, const Tensor<T>& a, const Tensor<T>& b, F 
           for (int64_t i = 0; i < n; ++i) gp[i] += g[i] * cj(d(av[i], bv[i], ov[i]));
         }
       };
+      // Distinct operands, one of which passes the gradient through: the other's part reads
+      // the output's gradient first, then the buffer is handed over if it can be.
+      if (an != bn && kAPasses && an->requires_grad && an->grad.empty()) {
+        part(bn, db);
+        if (!an->take_grad(*on)) part(an, da);
+        return;
+      }
+      if (an != bn && kBPasses && bn->requires_grad && bn->grad.empty()) {
+        part(an, da);
+        if (!bn->take_grad(*on)) part(bn, db);
+        return;
+      }
       part(an, da);
       part(bn, db);
       return;
@@ -151,11 +165,11 @@ template <class T, class F, class DF> Tensor<T> unary_op(const Tensor<T>& x, F f
 
 // ---- binary -------------------------------------------------------------------------------
 template <class T> Tensor<T> add(const Tensor<T>& a, const Tensor<T>& b) {
-  return binary_op<T>(
+  return binary_op<T, true, true>(
       "add", a, b, [](T x, T y) { return x + y; }, [](T, T, T) { return T(1); }, [](T, T, T) { return T(1); });
 }
 template <class T> Tensor<T> sub(const Tensor<T>& a, const Tensor<T>& b) {
-  return binary_op<T>(
+  return binary_op<T, true>(
       "sub", a, b, [](T x, T y) { return x - y; }, [](T, T, T) { return T(1); }, [](T, T, T) { return T(-1); });
 }
 template <class T> Tensor<T> mul(const Tensor<T>& a, const Tensor<T>& b) {

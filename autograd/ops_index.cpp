@@ -41,17 +41,30 @@ Csr make_csr(const Index& index, int64_t num_rows) {
 
 // dst[index[p]] += src[p] (rows of width C) as a segment sum: parallel over receivers,
 // deterministic. `scale`, if given, multiplies each receiver's row afterwards (scatter_mean;
-// dst must then start at 0).
+// dst must then start at 0). overwrite: dst's old values are not read; each row becomes its
+// sum (0 where nothing points), so a first gradient needs no zero fill beforehand.
 template <class T> void scatter_add_csr(T* dst, const T* src, const Index& index, int64_t num_rows, int64_t C,
-                                        const real_t<T>* scale = nullptr) {
-  if (index.empty()) return;
+                                        const real_t<T>* scale = nullptr, bool overwrite = false) {
+  if (index.empty()) {
+    if (overwrite) std::fill(dst, dst + num_rows * C, T(0));
+    return;
+  }
   const Csr c = make_csr(index, num_rows);
   const int64_t n = static_cast<int64_t>(index.size());
 #pragma omp parallel for schedule(static) if (n * C > kParallelMin)
   for (int64_t r = 0; r < num_rows; ++r) {
-    const int64_t b = c.offset[r], e = c.offset[r + 1];
-    if (b == e) continue;
+    int64_t b = c.offset[r];
+    const int64_t e = c.offset[r + 1];
     T* d = dst + r * C;
+    if (overwrite) {
+      if (b == e) {
+        std::fill(d, d + C, T(0));
+        continue;
+      }
+      std::copy(src + c.pos[b] * C, src + (c.pos[b] + 1) * C, d);
+      ++b;
+    }
+    if (b == e && !overwrite) continue;
     for (int64_t k = b; k < e; ++k) {
       const T* s = src + c.pos[k] * C;
       for (int64_t j = 0; j < C; ++j) d[j] += s[j];
@@ -75,9 +88,55 @@ template <class T> Tensor<T> index_select_rows(const Tensor<T>& x, const Index& 
   for (int64_t i = 0; i < N; ++i) std::copy(s + index[i] * C, s + (index[i] + 1) * C, o + i * C);
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), index, C] {
     if (!xn->requires_grad) return;
-    xn->ensure_grad();
-    scatter_add_csr(xn->grad.data(), on->grad.data(), index, xn->shape[0], C);
+    const bool first = xn->claim_whole_grad();
+    scatter_add_csr(xn->grad.data(), on->grad.data(), index, xn->shape[0], C, nullptr, first);
   });
+  return out;
+}
+
+// ---- add_gathered_rows (an edge's input in message passing) -----------------------------------
+template <class T> Tensor<T> add_gathered_rows(const Tensor<T>& base, const Tensor<T>& a, const Index& ia,
+                                               const Tensor<T>& b, const Index& ib) {
+  check_2d("add_gathered_rows", base.shape());
+  check_2d("add_gathered_rows", a.shape());
+  check_2d("add_gathered_rows", b.shape());
+  const int64_t N = base.rows(), C = base.cols();
+  if (a.cols() != C || b.cols() != C)
+    throw Error("add_gathered_rows: widths differ, base " + shape_str(base.shape()) + ", a " + shape_str(a.shape()) +
+                ", b " + shape_str(b.shape()));
+  if (static_cast<int64_t>(ia.size()) != N || static_cast<int64_t>(ib.size()) != N)
+    throw Error("add_gathered_rows: " + std::to_string(ia.size()) + " and " + std::to_string(ib.size()) +
+                " indices for " + std::to_string(N) + " rows of base");
+  check_index("add_gathered_rows", ia, a.rows(), a.shape());
+  check_index("add_gathered_rows", ib, b.rows(), b.shape());
+  auto out = new_output_overwritten<T>({N, C});
+  const T *x = base.data(), *pa = a.data(), *pb = b.data();
+  T* o = out.data();
+#pragma omp parallel for if (N * C > kParallelMin)
+  for (int64_t i = 0; i < N; ++i) {
+    const T *xr = x + i * C, *ar = pa + ia[i] * C, *br = pb + ib[i] * C;
+    T* orow = o + i * C;
+    for (int64_t j = 0; j < C; ++j) orow[j] = xr[j] + (ar[j] + br[j]);
+  }
+  record(out.node(), {base.node_ptr(), a.node_ptr(), b.node_ptr()},
+         [xn = &base.node(), an = &a.node(), bn = &b.node(), on = &out.node(), ia, ib, C] {
+           const T* g = on->grad.data();
+           for (auto [pn, index] : {std::pair{an, &ia}, std::pair{bn, &ib}}) {
+             if (!pn->requires_grad) continue;
+             const bool first = pn->claim_whole_grad();
+             scatter_add_csr(pn->grad.data(), g, *index, pn->shape[0], C, nullptr, first);
+           }
+           // base's gradient is g itself: last, since it may take over g's buffer.
+           if (!xn->requires_grad || xn->take_grad(*on)) return;
+           const int64_t n = static_cast<int64_t>(on->value.size());
+           const bool first = xn->claim_whole_grad();
+           T* gx = xn->grad.data();
+           if (first)
+             std::copy(g, g + n, gx);
+           else
+#pragma omp parallel for if (n > kParallelMin)
+             for (int64_t i = 0; i < n; ++i) gx[i] += g[i];
+         });
   return out;
 }
 
@@ -94,17 +153,20 @@ static void check_scatter(const char* op, const Shape& xs, const Index& index, i
 template <class T> Tensor<T> scatter_add_rows(const Tensor<T>& x, const Index& index, int64_t num_rows) {
   check_scatter("scatter_add_rows", x.shape(), index, num_rows);
   const int64_t N = x.rows(), C = x.cols();
-  auto out = new_output<T>({num_rows, C});
-  scatter_add_csr(out.data(), x.data(), index, num_rows, C);
+  auto out = new_output_overwritten<T>({num_rows, C});  // each row its sum, or 0
+  scatter_add_csr(out.data(), x.data(), index, num_rows, C, nullptr, true);
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), index, C, N] {
     if (!xn->requires_grad) return;
-    xn->ensure_grad();
+    const bool first = xn->claim_whole_grad();
     T* g = xn->grad.data();
     const T* go = on->grad.data();
 #pragma omp parallel for if (N * C > kParallelMin)
     for (int64_t i = 0; i < N; ++i) {
       const T* s = go + index[i] * C;
-      for (int64_t j = 0; j < C; ++j) g[i * C + j] += s[j];
+      if (first)
+        std::copy(s, s + C, g + i * C);
+      else
+        for (int64_t j = 0; j < C; ++j) g[i * C + j] += s[j];
     }
   });
   return out;
@@ -195,11 +257,13 @@ template <class T> Tensor<T> interpolate_rows(const Tensor<T>& x, const Index& i
   return out;
 }
 
-#define AG_INSTANTIATE(T)                                                           \
-  template Tensor<T> index_select_rows<T>(const Tensor<T>&, const Index&);          \
-  template Tensor<T> scatter_add_rows<T>(const Tensor<T>&, const Index&, int64_t);  \
-  template Tensor<T> scatter_mean_rows<T>(const Tensor<T>&, const Index&, int64_t); \
-  template Tensor<T> interpolate_rows<T>(const Tensor<T>&, const Index&, const Tensor<T>&);
+#define AG_INSTANTIATE(T)                                                                                     \
+  template Tensor<T> index_select_rows<T>(const Tensor<T>&, const Index&);                                    \
+  template Tensor<T> scatter_add_rows<T>(const Tensor<T>&, const Index&, int64_t);                            \
+  template Tensor<T> scatter_mean_rows<T>(const Tensor<T>&, const Index&, int64_t);                           \
+  template Tensor<T> interpolate_rows<T>(const Tensor<T>&, const Index&, const Tensor<T>&);                   \
+  template Tensor<T> add_gathered_rows<T>(const Tensor<T>&, const Tensor<T>&, const Index&, const Tensor<T>&, \
+                                          const Index&);
 AG_INSTANTIATE(float)
 AG_INSTANTIATE(double)
 AG_INSTANTIATE(std::complex<float>)

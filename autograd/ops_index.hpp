@@ -10,6 +10,13 @@ template <class T> Tensor<T> index_select_rows(const Tensor<T>& x, const Index& 
 // out[index[i]] += x[i]: x [N x C], index values in [0, num_rows) -> [num_rows x C]
 // (segment sum; rows nobody points at stay 0).
 template <class T> Tensor<T> scatter_add_rows(const Tensor<T>& x, const Index& index, int64_t num_rows);
+// out[i] = base[i] + (a[ia[i]] + b[ib[i]]): base [N x C], a [Ra x C], b [Rb x C], N indices
+// each -> [N x C]. A message-passing edge's input (its own projection plus its sender's and
+// receiver's) in one pass, equal bit for bit to add(base, add(index_select_rows(a, ia),
+// index_select_rows(b, ib))) without the three [N x C] temporaries, and in backward without
+// their gradients: d base = g, d a = scatter_add_rows(g, ia), d b = scatter_add_rows(g, ib).
+template <class T> Tensor<T> add_gathered_rows(const Tensor<T>& base, const Tensor<T>& a, const Index& ia,
+                                               const Tensor<T>& b, const Index& ib);
 // Like scatter_add_rows, divided by the number of contributions (0 rows stay 0).
 template <class T> Tensor<T> scatter_mean_rows(const Tensor<T>& x, const Index& index, int64_t num_rows);
 // out[i] = sum_k weight[i,k] * x[index[i,k]]: x [R x C], index [N x K] row-major (K per row),

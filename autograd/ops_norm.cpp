@@ -106,14 +106,14 @@ template <class T> Tensor<T> channel_norm(const Tensor<T>& x, T eps) {
     gain[j] = st.y_gain;
     inv[j] = st.inv;
   }
-  auto out = new_output<T>({R, C});
+  auto out = new_output_overwritten<T>({R, C});  // every element written below
   T* o = out.data();
 #pragma omp parallel for if (R * C > kParallelMin)
   for (int64_t r = 0; r < R; ++r)
     for (int64_t j = 0; j < C; ++j) o[r * C + j] = (px[r * C + j] * isc[j] - mu[j]) * gain[j];
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), inv, R, C] {
     if (!xn->requires_grad) return;
-    xn->ensure_grad();
+    const bool first = xn->claim_whole_grad();
     const T* g = on->grad.data();
     const T* y = on->value.data();
     // dx = inv * (g - mean(g) - y * mean(g y)) per column
@@ -131,7 +131,8 @@ template <class T> Tensor<T> channel_norm(const Tensor<T>& x, T eps) {
     for (int64_t r = 0; r < R; ++r)
       for (int64_t j = 0; j < C; ++j) {
         const int64_t k = r * C + j;
-        gx[k] += inv[j] * (g[k] - s[j] - y[k] * s[C + j]);
+        const T d = inv[j] * (g[k] - s[j] - y[k] * s[C + j]);
+        gx[k] = first ? d : gx[k] + d;
       }
   });
   return out;
@@ -143,7 +144,7 @@ template <class T> Tensor<T> layer_norm(const Tensor<T>& x, T eps) {
   const int64_t R = x.rows(), C = x.cols();
   if (C == 0) throw Error("layer_norm: no columns in " + shape_str(x.shape()));
   check_eps("layer_norm", eps);
-  auto out = new_output<T>({R, C});
+  auto out = new_output_overwritten<T>({R, C});  // every row written below
   std::vector<T> inv(static_cast<size_t>(R));
   const T* px = x.data();
   T* o = out.data();
@@ -164,7 +165,7 @@ template <class T> Tensor<T> layer_norm(const Tensor<T>& x, T eps) {
   }
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), inv = std::move(inv), R, C] {
     if (!xn->requires_grad) return;
-    xn->ensure_grad();
+    const bool first = xn->claim_whole_grad();
     const T* g = on->grad.data();
     const T* y = on->value.data();
     T* gx = xn->grad.data();
@@ -179,7 +180,10 @@ template <class T> Tensor<T> layer_norm(const Tensor<T>& x, T eps) {
       }
       mg /= T(C);
       mgy /= T(C);
-      for (int64_t j = 0; j < C; ++j) gx[r * C + j] += inv[r] * (gr[j] - mg - yr[j] * mgy);
+      for (int64_t j = 0; j < C; ++j) {
+        const T d = inv[r] * (gr[j] - mg - yr[j] * mgy);
+        gx[r * C + j] = first ? d : gx[r * C + j] + d;
+      }
     }
   });
   return out;

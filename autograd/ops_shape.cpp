@@ -19,7 +19,7 @@ template <class T> Tensor<T> concat_cols(const std::vector<Tensor<T>>& xs) {
     off.push_back(off.back() + x.cols());
   }
   const int64_t C = off.back();
-  auto out = new_output<T>({R, C});
+  auto out = new_output_overwritten<T>({R, C});  // every column copied below
   T* o = out.data();
   for (size_t k = 0; k < xs.size(); ++k) {
     const T* s = xs[k].data();
@@ -37,13 +37,17 @@ template <class T> Tensor<T> concat_cols(const std::vector<Tensor<T>>& xs) {
     for (size_t k = 0; k < nodes.size(); ++k) {
       Node<T>* xn = nodes[k];
       if (!xn->requires_grad) continue;
-      xn->ensure_grad();
+      const bool first = xn->claim_whole_grad();
       const int64_t c = off[k + 1] - off[k], o0 = off[k];
       T* g = xn->grad.data();
       const T* go = on->grad.data();
 #pragma omp parallel for if (R * c > kParallelMin)
-      for (int64_t r = 0; r < R; ++r)
-        for (int64_t j = 0; j < c; ++j) g[r * c + j] += go[r * C + o0 + j];
+      for (int64_t r = 0; r < R; ++r) {
+        if (first)
+          std::copy(go + r * C + o0, go + r * C + o0 + c, g + r * c);
+        else
+          for (int64_t j = 0; j < c; ++j) g[r * c + j] += go[r * C + o0 + j];
+      }
     }
   });
   return out;
@@ -63,7 +67,7 @@ template <class T> Tensor<T> concat_rows(const std::vector<Tensor<T>>& xs) {
   }
   int64_t R = 0;
   for (const auto& x : xs) R += x.rows();
-  auto out = new_output<T>({R, C});
+  auto out = new_output_overwritten<T>({R, C});  // every part copied below
   for (size_t k = 0; k < xs.size(); ++k)
     std::copy(xs[k].values().begin(), xs[k].values().end(), out.values().begin() + off[k]);
   std::vector<std::shared_ptr<NodeBase>> parents;
@@ -76,11 +80,14 @@ template <class T> Tensor<T> concat_rows(const std::vector<Tensor<T>>& xs) {
     for (size_t k = 0; k < nodes.size(); ++k) {
       Node<T>* xn = nodes[k];
       if (!xn->requires_grad) continue;
-      xn->ensure_grad();
+      const bool first = xn->claim_whole_grad();
       const int64_t n = off[k + 1] - off[k];
       T* g = xn->grad.data();
       const T* go = on->grad.data() + off[k];
-      for (int64_t i = 0; i < n; ++i) g[i] += go[i];
+      if (first)
+        std::copy(go, go + n, g);
+      else
+        for (int64_t i = 0; i < n; ++i) g[i] += go[i];
     }
   });
   return out;
@@ -94,19 +101,30 @@ template <class T> Tensor<T> slice_cols(const Tensor<T>& x, int64_t begin, int64
     throw Error("slice_cols: range [" + std::to_string(begin) + ", " + std::to_string(end) +
                 ") outside the columns of " + shape_str(x.shape()));
   const int64_t c = end - begin;
-  auto out = new_output<T>({R, c});
+  auto out = new_output_overwritten<T>({R, c});  // every row copied below
   const T* s = x.data();
   T* o = out.data();
 #pragma omp parallel for if (R * c > kParallelMin)
   for (int64_t r = 0; r < R; ++r) std::copy(s + r * C + begin, s + r * C + end, o + r * c);
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), R, C, c, begin] {
     if (!xn->requires_grad) return;
-    xn->ensure_grad();
+    // The first gradient of these columns is written (GDSR's edge MLPs slice one weight three
+    // ways); columns no slice writes are zeroed when x is settled.
+    const ColumnRanges cols{{begin, begin + c}};
+    const bool first = c > 0 && xn->grad_columns_unwritten(cols);
+    if (first)
+      xn->claim_grad_columns(cols);
+    else
+      xn->ensure_grad();
     T* g = xn->grad.data();
     const T* go = on->grad.data();
 #pragma omp parallel for if (R * c > kParallelMin)
-    for (int64_t r = 0; r < R; ++r)
-      for (int64_t j = 0; j < c; ++j) g[r * C + begin + j] += go[r * c + j];
+    for (int64_t r = 0; r < R; ++r) {
+      if (first)
+        std::copy(go + r * c, go + (r + 1) * c, g + r * C + begin);
+      else
+        for (int64_t j = 0; j < c; ++j) g[r * C + begin + j] += go[r * c + j];
+    }
   });
   return out;
 }
@@ -118,7 +136,7 @@ template <class T> Tensor<T> slice_rows(const Tensor<T>& x, int64_t begin, int64
   if (begin < 0 || end < begin || end > R)
     throw Error("slice_rows: range [" + std::to_string(begin) + ", " + std::to_string(end) + ") outside the rows of " +
                 shape_str(x.shape()));
-  auto out = new_output<T>({end - begin, C});
+  auto out = new_output_overwritten<T>({end - begin, C});  // copied below
   std::copy(x.data() + begin * C, x.data() + end * C, out.data());
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node(), begin, C] {
     if (!xn->requires_grad) return;
@@ -137,10 +155,13 @@ template <class T> Tensor<T> reshape(const Tensor<T>& x, const Shape& shape) {
     throw Error("reshape: element counts differ, " + shape_str(x.shape()) + " vs " + shape_str(shape));
   auto out = Tensor<T>::from(shape, x.values());
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node()] {
-    if (!xn->requires_grad) return;
-    xn->ensure_grad();
+    if (!xn->requires_grad || xn->take_grad(*on)) return;  // the same elements: hand the buffer over
+    const bool first = xn->claim_whole_grad();
     const size_t n = on->grad.size();
-    for (size_t i = 0; i < n; ++i) xn->grad[i] += on->grad[i];
+    if (first)
+      std::copy(on->grad.begin(), on->grad.end(), xn->grad.begin());
+    else
+      for (size_t i = 0; i < n; ++i) xn->grad[i] += on->grad[i];
   });
   return out;
 }

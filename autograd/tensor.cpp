@@ -84,12 +84,15 @@ void backward_from(const std::shared_ptr<NodeBase>& root, bool retain_graph) {
 
   // Intermediates start from zero (matters when a graph is retained and run twice).
   for (NodeBase* n : order)
-    if (n->backward_fn) n->zero_grad();
+    if (n->backward_fn) n->zero_grad(), n->grad_is_last_use = false;
   root->seed_grad_one();
   for (auto it = order.rbegin(); it != order.rend(); ++it) {
     NodeBase* n = *it;
     n->settle_grad();  // every op that adds into n has run; columns nobody wrote become 0
-    if (n->backward_fn) n->backward_fn();
+    if (!n->backward_fn) continue;
+    n->grad_is_last_use = !retain_graph;
+    n->backward_fn();
+    n->grad_is_last_use = false;
   }
   if (!retain_graph) {
     // Free intermediates: drop closures and edges; gradients of non-leaves are released.
@@ -160,6 +163,15 @@ template <class T> bool Node<T>::claim_whole_grad() {
     return false;
   }
   allocate_unset(grad, value.size());
+  return true;
+}
+
+template <class T> bool Node<T>::take_grad(Node& out) {
+  if (&out == this || !grad.empty() || !out.grad_is_last_use || out.grad.size() != value.size() ||
+      !out.unwritten_columns.empty())
+    return false;
+  grad = std::move(out.grad);
+  out.grad.clear();  // moved-from: make it empty for certain
   return true;
 }
 

@@ -94,6 +94,10 @@ struct NodeBase {
   // Set when a backward() without retain_graph released this intermediate's history: a later
   // backward() that reaches it throws instead of treating it as a leaf.
   bool freed = false;
+  // True only while this node's own backward_fn runs in a backward() without retain_graph:
+  // nothing reads this node's gradient after that op, so the op may hand the buffer to a
+  // parent (Node::take_grad) instead of copying it.
+  bool grad_is_last_use = false;
   virtual void zero_grad() = 0;
   virtual void seed_grad_one() = 0;  // grad := 1 (scalar root)
   virtual void settle_grad() = 0;    // see Node::settle_grad
@@ -131,6 +135,13 @@ template <class T> struct Node final : NodeBase {
   // has flowed in yet (grad is then allocated unset and the op writes it), false after
   // ensure_grad (the op adds). Saves the zero fill and a read of every first gradient.
   bool claim_whole_grad();
+  // For an op whose gradient for this input is its output's gradient unchanged (add, sub's
+  // first operand), called after the op's other parts have read `out`'s gradient: takes over
+  // that buffer (no allocation, no copy) and returns true if nothing has flowed into this
+  // node yet, `out` has the same size and its gradient is at its last use (see
+  // NodeBase::grad_is_last_use). Otherwise returns false and changes nothing; the op then
+  // writes or adds as usual.
+  bool take_grad(Node& out);
   void settle_grad() override;  // zeroes the unwritten columns; then grad is a plain gradient
   void zero_grad() override { grad.clear(), unwritten_columns.clear(); }
   void seed_grad_one() override { fill(grad, numel(), T(1)), unwritten_columns.clear(); }

@@ -50,7 +50,7 @@ template <class T> ag::Tensor<T> edge_update(const nn::MLPBlock<T>& mlp, const a
   const ag::Tensor<T> xs = ag::linear(x, ag::slice_cols(W, 0, L), ag::Tensor<T>());
   const ag::Tensor<T> xd = ag::linear(x, ag::slice_cols(W, L, 2 * L), ag::Tensor<T>());
   ag::Tensor<T> pre = ag::linear(e, ag::slice_cols(W, 2 * L, 3 * L), mlp.linear1->bias);
-  pre = ag::add(pre, ag::add(ag::index_select_rows(xs, src), ag::index_select_rows(xd, dst)));
+  pre = ag::add_gathered_rows(pre, xs, src, xd, dst);  // pre + (xs[src] + xd[dst])
   return ag::add(e, mlp.after_first(ag::leaky_relu(pre, static_cast<T>(nn::MLPBlock<T>::kSlope))));
 }
 }  // namespace

@@ -219,3 +219,45 @@ TEST_CASE("core: first gradients written, later ones added, also when both opera
     if (pass == 1) loss().backward();
   }
 }
+
+// add and sub hand their output's gradient buffer to a fresh operand (Node::take_grad)
+// instead of copying it, only when nothing reads that gradient again.
+TEST_CASE("core: a passed-through gradient is handed over only at its last use") {
+  ag::Node<double> out, a, b;
+  out.shape = a.shape = b.shape = {2, 3};
+  out.value.assign(6, 0.0), a.value.assign(6, 0.0), b.value.assign(6, 0.0);
+  out.grad.assign(6, 2.0);
+  CHECK_FALSE(a.take_grad(out));  // not at its last use (retain_graph, or outside backward)
+  out.grad_is_last_use = true;
+  b.grad.assign(6, 1.0);
+  CHECK_FALSE(b.take_grad(out));  // b already has a gradient: the op adds instead
+  CHECK_FALSE(out.take_grad(out));
+  const double* buffer = out.grad.data();
+  CHECK(a.take_grad(out));
+  CHECK(a.grad.data() == buffer);
+  CHECK(out.grad.empty());
+  CHECK(a.grad == ag::Storage<double>(6, 2.0));
+
+  // Through backward: values are right whether the buffer moved or not, and a retained graph
+  // keeps every intermediate's gradient readable and gives the same result twice.
+  auto check = [](bool retain) {
+    CAPTURE(retain);
+    Tensord x = randn({4, 3}, 21).set_requires_grad(true), y = randn({4, 3}, 22).set_requires_grad(true);
+    const Tensord w = randn({4, 3}, 23);
+    const Tensord s = ag::add(x, y), d = ag::sub(s, ag::mul(y, y)), t = ag::add(d, d);
+    ag::sum(ag::mul(t, w)).backward(retain);
+    if (retain) CHECK(s.grad() == (w * 2.0).values());
+    for (int64_t i = 0; i < 12; ++i) {
+      CHECK(x.grad()[i] == doctest::Approx(2 * w.values()[i]).epsilon(1e-15));
+      CHECK(y.grad()[i] == doctest::Approx(2 * w.values()[i] * (1 - 2 * y.values()[i])).epsilon(1e-15));
+    }
+    if (!retain) return;
+    const ag::Storage<double> gx = x.grad(), gy = y.grad();
+    x.zero_grad(), y.zero_grad();
+    ag::sum(ag::mul(t, w)).backward();
+    CHECK(x.grad() == gx);
+    CHECK(y.grad() == gy);
+  };
+  check(false);
+  check(true);
+}

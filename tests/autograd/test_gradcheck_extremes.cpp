@@ -361,6 +361,18 @@ std::vector<OpRows> table() {
   t.push_back(op(
       "scatter_mean_rows", [](const auto& x) { return ag::scatter_mean_rows(x[0], kScatter, 5); }, scaled({u43}),
       [scatter_ref](const std::vector<LIn>& a) { return scatter_ref(a[0], true); }, lin));
+  t.push_back(op(
+      "add_gathered_rows", [](const auto& x) { return ag::add_gathered_rows(x[0], x[1], kSelect, x[2], kScatter); },
+      scaled({u43, v43, randn({4, 3}, 121)}),
+      [](const std::vector<LIn>& a) {
+        std::vector<LD> o;
+        for (int64_t i = 0; i < 4; ++i)
+          for (int64_t c = 0; c < 3; ++c)
+            o.push_back(a[0].at(i, c) +
+                        (a[1].at(kSelect[static_cast<size_t>(i)], c) + a[2].at(kScatter[static_cast<size_t>(i)], c)));
+        return o;
+      },
+      lin));
   // Barycentric weights are unit-free: only the rows scale.
   t.push_back(op(
       "interpolate_rows", [](const auto& x) { return ag::interpolate_rows(x[0], kInterp, x[1]); },
@@ -718,6 +730,7 @@ std::vector<OpRows> table() {
                                             "concat / slice",
                                             "index_select_rows",
                                             "scatter_add_rows",
+                                            "add_gathered_rows",
                                             "scatter_mean_rows",
                                             "normalize_rows",
                                             "channel_norm",

@@ -62,6 +62,35 @@ TEST_CASE("index: complex gather, scatter and interpolate") {
              {re, im, wr, wi});
 }
 
+// The fused edge input equals the three-op composition bit for bit, value and gradients,
+// also when operands are one tensor (its gradient then sums both parts).
+TEST_CASE("index: add_gathered_rows is add(base, add(gather a, gather b))") {
+  const Tensord base = randn({9, 4}, 51), a = randn({5, 4}, 52), b = randn({6, 4}, 53);
+  const ag::Index ia{4, 0, 0, 2, 4, 4, 1, 3, 0}, ib{5, 5, 0, 1, 2, 0, 3, 3, 5};  // row 4 of b: never gathered
+  check_grad("add_gathered_rows", kTol, [&](auto& in) { return ag::add_gathered_rows(in[0], in[1], ia, in[2], ib); },
+             {base, a, b});
+  const Tensord w = randn({9, 4}, 54);
+  auto run = [&](bool fused, bool same) {
+    Tensord x = base.detach().set_requires_grad(true), p = a.detach().set_requires_grad(true),
+            q = b.detach().set_requires_grad(true);
+    const Tensord& qq = same ? p : q;
+    const ag::Index& jb = same ? ia : ib;
+    const Tensord y = fused ? ag::add_gathered_rows(x, p, ia, qq, jb)
+                            : ag::add(x, ag::add(ag::index_select_rows(p, ia), ag::index_select_rows(qq, jb)));
+    sum(ag::mul(y, w)).backward();
+    std::vector<double> r = ag::to_vector(y.values());
+    for (const Tensord* t : {&x, &p, &q})
+      if (t->has_grad()) r.insert(r.end(), t->grad().begin(), t->grad().end());
+    return r;
+  };
+  CHECK(run(true, false) == run(false, false));
+  CHECK(run(true, true) == run(false, true));
+  CHECK_THROWS_WITH_AS(ag::add_gathered_rows(base, a, {0, 1}, b, ib), doctest::Contains("indices"), ag::Error);
+  CHECK_THROWS_WITH_AS(ag::add_gathered_rows(base, randn({5, 3}, 55), ia, b, ib), doctest::Contains("widths"),
+                       ag::Error);
+  CHECK_THROWS_AS(ag::add_gathered_rows(base, a, ib, b, ib), ag::Error);  // 5 is outside a's 5 rows
+}
+
 TEST_CASE("index: out-of-range indices are refused") {
   const Tensord x = randn({3, 2}, 11);
   CHECK_THROWS_WITH_AS(ag::index_select_rows(x, {0, 3}), doctest::Contains("index_select_rows"), ag::Error);
