@@ -56,15 +56,14 @@ template <class T> void scatter_add_csr(T* dst, const T* src, const Index& index
     int64_t b = c.offset[r];
     const int64_t e = c.offset[r + 1];
     T* d = dst + r * C;
-    if (overwrite) {
-      if (b == e) {
-        std::fill(d, d + C, T(0));
-        continue;
-      }
+    if (b == e) {  // nothing points here
+      if (overwrite) std::fill(d, d + C, T(0));
+      continue;
+    }
+    if (overwrite) {  // the first source is copied, the others added
       std::copy(src + c.pos[b] * C, src + (c.pos[b] + 1) * C, d);
       ++b;
     }
-    if (b == e && !overwrite) continue;
     for (int64_t k = b; k < e; ++k) {
       const T* s = src + c.pos[k] * C;
       for (int64_t j = 0; j < C; ++j) d[j] += s[j];
