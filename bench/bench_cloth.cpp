@@ -166,8 +166,11 @@ BENCHMARK(BM_ClothSkirtShort)
     ->Args({10, 40, 1, 0, 30, 4})
     ->Args({10, 20, 2, 1, 30, 4})
     ->Args({10, 10, 2, 1, 30, 4})
-    // Tighter self-contact slack, detected less often: faster on this calm clip, but in the
-    // jumps of 2 s of 01_01 the 10 mm skirt was clean on 46% of frames (100% at the default).
+    // Half the self-contact slack, detected at most every 8 substeps: at 10 mm the same figures
+    // here in 0.59x the time (skirt_short on 01_01 1-3 s and salsa 60_02 2-4 s through `data
+    // make --self-slack 0.0015 --self-detect-every 8`: equal validity figures, HR 1.4-1.7x
+    // faster; skirt_tiered at 10 mm too), but at 30 mm skirt_tiered on 01_01 3-4 s had 35% clean
+    // frames (100% at the default), so it is not the default.
     ->Args({10, 20, 2, 1, 15, 8})
     ->ArgNames({"mm", "substeps", "iterations", "self", "slack_0.1mm", "detect"})
     ->Unit(benchmark::kSecond)
