@@ -127,14 +127,11 @@ template <class T> Tensor<T> add_gathered_rows(const Tensor<T>& base, const Tens
            }
            // base's gradient is g itself: last, since it may take over g's buffer.
            if (!xn->requires_grad || xn->take_grad(*on)) return;
-           const int64_t n = static_cast<int64_t>(on->value.size());
            const bool first = xn->claim_whole_grad();
            T* gx = xn->grad.data();
-           if (first)
-             std::copy(g, g + n, gx);
-           else
-#pragma omp parallel for if (n > kParallelMin)
-             for (int64_t i = 0; i < n; ++i) gx[i] += g[i];
+           const int64_t N = xn->shape[0];
+#pragma omp parallel for if (N * C > kParallelMin)
+           for (int64_t i = 0; i < N; ++i) write_or_add(gx + i * C, g + i * C, C, first);
          });
   return out;
 }
@@ -161,11 +158,7 @@ template <class T> Tensor<T> scatter_add_rows(const Tensor<T>& x, const Index& i
     const T* go = on->grad.data();
 #pragma omp parallel for if (N * C > kParallelMin)
     for (int64_t i = 0; i < N; ++i) {
-      const T* s = go + index[i] * C;
-      if (first)
-        std::copy(s, s + C, g + i * C);
-      else
-        for (int64_t j = 0; j < C; ++j) g[i * C + j] += s[j];
+      write_or_add(g + i * C, go + index[i] * C, C, first);
     }
   });
   return out;

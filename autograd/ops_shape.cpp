@@ -42,12 +42,7 @@ template <class T> Tensor<T> concat_cols(const std::vector<Tensor<T>>& xs) {
       T* g = xn->grad.data();
       const T* go = on->grad.data();
 #pragma omp parallel for if (R * c > kParallelMin)
-      for (int64_t r = 0; r < R; ++r) {
-        if (first)
-          std::copy(go + r * C + o0, go + r * C + o0 + c, g + r * c);
-        else
-          for (int64_t j = 0; j < c; ++j) g[r * c + j] += go[r * C + o0 + j];
-      }
+      for (int64_t r = 0; r < R; ++r) write_or_add(g + r * c, go + r * C + o0, c, first);
     }
   });
   return out;
@@ -84,10 +79,7 @@ template <class T> Tensor<T> concat_rows(const std::vector<Tensor<T>>& xs) {
       const int64_t n = off[k + 1] - off[k];
       T* g = xn->grad.data();
       const T* go = on->grad.data() + off[k];
-      if (first)
-        std::copy(go, go + n, g);
-      else
-        for (int64_t i = 0; i < n; ++i) g[i] += go[i];
+      write_or_add(g, go, n, first);
     }
   });
   return out;
@@ -119,12 +111,7 @@ template <class T> Tensor<T> slice_cols(const Tensor<T>& x, int64_t begin, int64
     T* g = xn->grad.data();
     const T* go = on->grad.data();
 #pragma omp parallel for if (R * c > kParallelMin)
-    for (int64_t r = 0; r < R; ++r) {
-      if (first)
-        std::copy(go + r * c, go + (r + 1) * c, g + r * C + begin);
-      else
-        for (int64_t j = 0; j < c; ++j) g[r * C + begin + j] += go[r * c + j];
-    }
+    for (int64_t r = 0; r < R; ++r) write_or_add(g + r * C + begin, go + r * c, c, first);
   });
   return out;
 }
@@ -157,11 +144,7 @@ template <class T> Tensor<T> reshape(const Tensor<T>& x, const Shape& shape) {
   record(out.node(), {x.node_ptr()}, [xn = &x.node(), on = &out.node()] {
     if (!xn->requires_grad || xn->take_grad(*on)) return;  // the same elements: hand the buffer over
     const bool first = xn->claim_whole_grad();
-    const size_t n = on->grad.size();
-    if (first)
-      std::copy(on->grad.begin(), on->grad.end(), xn->grad.begin());
-    else
-      for (size_t i = 0; i < n; ++i) xn->grad[i] += on->grad[i];
+    write_or_add(xn->grad.data(), on->grad.data(), static_cast<int64_t>(on->grad.size()), first);
   });
   return out;
 }

@@ -85,6 +85,14 @@ template <class T> std::vector<T> to_vector(const Storage<T>& v) { return std::v
 // paper-preset inference frame).
 template <class T> void fill(Storage<T>& v, int64_t n, T x);
 
+// dst[0, n) = src[0, n) for a first gradient (Node::claim_whole_grad returned true), else +=.
+template <class T> void write_or_add(T* dst, const T* src, int64_t n, bool first) {
+  if (first)
+    std::copy(src, src + n, dst);
+  else
+    for (int64_t i = 0; i < n; ++i) dst[i] += src[i];
+}
+
 // ---- graph nodes -----------------------------------------------------------------------
 struct NodeBase {
   virtual ~NodeBase() = default;
