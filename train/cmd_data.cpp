@@ -63,6 +63,7 @@ struct MakeArgs {
   // Solver knobs (NaN / <0: the solver's default, sim::SimParams).
   int iterations = -1, stretch_passes = -1, settle_frames = -1, contact_every = -1, self_detect_every = -1;
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN, self_slack = NAN;
+  double self_slack_per_pd = NAN;
   bool self_collision = true;
   bool independent_hr = false;  // settle HR from its own placement, not from the settled LR garment
   bool skip_built = false;      // keep --out when it already holds this clip, built and valid
@@ -181,6 +182,7 @@ void run_make(const MakeArgs& a) {
   if (!std::isnan(a.bend_stiffness)) params.bend_stiffness = a.bend_stiffness;
   if (!std::isnan(a.self_thickness)) params.self_thickness = a.self_thickness;
   if (!std::isnan(a.self_slack)) params.self_slack = a.self_slack;
+  if (!std::isnan(a.self_slack_per_pd)) params.self_slack_per_pd = a.self_slack_per_pd;
   if (a.self_detect_every > 0) params.self_detect_every = a.self_detect_every;
   if (!std::isnan(a.compression_ratio)) params.compression_ratio = a.compression_ratio;
   params.self_collision = a.self_collision;
@@ -231,6 +233,7 @@ void run_make(const MakeArgs& a) {
                   {"self_thickness_m", params.self_thickness},
                   {"self_thickness_per_pd", params.self_thickness_per_pd},
                   {"self_slack_m", params.self_slack},
+                  {"self_slack_per_pd", params.self_slack_per_pd},
                   {"self_detect_every", params.self_detect_every},
                   {"compression_ratio", params.compression_ratio},
                   {"compression_pd_ref_m", params.compression_pd_ref},
@@ -601,6 +604,10 @@ void add_data_command(CLI::App& app) {
                    "metres a vertex may leave its predicted path before self-contacts are re-detected"
                    " (default: the solver's; smaller is faster on smooth cloth, re-detects more in fast folds)")
       ->check(finite_range(1e-5, 0.05));
+  make->add_option("--self-slack-per-pd", mk->self_slack_per_pd,
+                   "the slack is at most this fraction of the particle distance, and --self-detect-every grows as it"
+                   " shrinks (default: the solver's; 10 lifts the cap, as before solver revision 8)")
+      ->check(finite_range(1e-3, 10.0));
   make->add_option("--self-detect-every", mk->self_detect_every,
                    "substeps between self-contact detections (default: the solver's)")
       ->check(CLI::Range(1, 1000));

@@ -204,11 +204,14 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
   xprev_ = x_;
   if (p.self_collision) {
     if (!(p.self_thickness > 0) || p.self_detect_every < 1 || !(p.self_slack > 0) || p.self_passes < 1 ||
-        !(p.self_thickness_per_pd >= 0))
+        !(p.self_thickness_per_pd >= 0) || !(p.self_slack_per_pd > 0))
       gdsr::fail("sim/cloth_solver",
-                 "self_thickness and self_slack must be positive, self_thickness_per_pd >= 0, self_detect_every and "
-                 "self_passes >= 1");
+                 "self_thickness, self_slack and self_slack_per_pd must be positive, self_thickness_per_pd >= 0, "
+                 "self_detect_every and self_passes >= 1");
     p_.self_thickness = std::max(p.self_thickness, p.self_thickness_per_pd * g.particle_distance);
+    if (g.particle_distance > 0) p_.self_slack = std::min(p.self_slack, p.self_slack_per_pd * g.particle_distance);
+    const double longer = std::round(p.self_detect_every * (p.self_slack / p_.self_slack));
+    p_.self_detect_every = static_cast<int>(std::min(longer, 1000.0));
     self_ = std::make_unique<SelfCollision>(F_, nv);
     motion_ = Points3::Zero(nv, 3);
   }

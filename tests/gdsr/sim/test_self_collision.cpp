@@ -110,6 +110,32 @@ TEST_CASE("self-collision: the detector flags crossing triangles as tangled") {
   CHECK(s1.num_vertex_triangle() == 0);
 }
 
+TEST_CASE("self-collision: a fine mesh gets a slack of 0.15 particle distances, detected less often") {
+  // Two resting sheets without gravity: nothing leaves its path, so detections come only on the
+  // schedule, one every self_detect_every substeps of the rule in effect.
+  struct Case {
+    double h, per_pd, slack;
+    int every;
+  };
+  for (const Case& c : {Case{0.03, 0.15, 0.003, 4}, Case{0.02, 0.15, 0.003, 4}, Case{0.015, 0.15, 0.00225, 5},
+                        Case{0.01, 0.15, 0.0015, 8}, Case{0.01, 10.0, 0.003, 4}}) {
+    CAPTURE(c.h);
+    CAPTURE(c.per_pd);
+    int nl = 0;
+    const sim::Garment g = two_sheets(c.h, nl);
+    sim::SimParams p;
+    p.settle_frames = 0;
+    p.gravity = Vec3::Zero();
+    p.self_slack_per_pd = c.per_pd;
+    sim::ClothSolver solver(g, gdsr::Faces(), Points3(), p);
+    CHECK(solver.params().self_slack == doctest::Approx(c.slack).epsilon(1e-12));
+    CHECK(solver.params().self_detect_every == c.every);
+    const int frames = 3;
+    for (int t = 0; t < frames; ++t) solver.step(Points3(), Points3(), 1.0 / 30);
+    CHECK(solver.num_self_detections() == (frames * p.substeps + c.every - 1) / c.every);
+  }
+}
+
 TEST_CASE("self-collision: a sheet dropped onto a clamped sheet lands on it at both resolutions") {
   for (double h : {0.03, 0.015}) {
     CAPTURE(h);
