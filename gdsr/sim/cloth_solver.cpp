@@ -326,6 +326,15 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
             }
           }
         }
+    // With self-contact (revision 9): only layers lying flat on each other are paired (normals
+    // within 60 degrees, the outer vertex on the inner one's outer side); across a fold the
+    // nearest inner vertex may face any way, and pushing along its normal drove the outer
+    // layer through the inner one (the 10 mm layered dress on CMU 01_01 tangled at the hip
+    // and blew up). Self-contact guards the rest.
+    if (self_ && best >= 0 &&
+        (N.row(v).dot(N.row(best)) < 0.5 * N.row(v).norm() * N.row(best).norm() ||
+         (x_.row(v) - x_.row(best)).dot(N.row(best)) < 0))
+      continue;
     if (best >= 0 && N.row(best).norm() > 0) layer_pairs_.push_back({v, best, N.row(best).normalized().transpose()});
   }
 }
@@ -431,6 +440,7 @@ void ClothSolver::solve_layers() {
     if (wo + wi == 0) continue;
     const double C = (x_.row(lp.outer) - x_.row(lp.inner)).dot(lp.normal.transpose()) - p_.layer_gap;
     if (C >= 0) continue;
+    if (self_ && C < -p_.layer_gap) continue;  // crossed since pairing: left to self-contact's untangling
     x_.row(lp.outer) -= (wo * C / (wo + wi)) * lp.normal.transpose();
     x_.row(lp.inner) += (wi * C / (wo + wi)) * lp.normal.transpose();
   }
