@@ -29,9 +29,11 @@ double radial_extent(const gdsr::TriMesh& b, const Vec3& axis, double y0, double
 }
 
 // Radial profile of the section of b at height y around the axis: for each direction
-// psi_k = 2 pi k / bins, the farthest crossing (below max_r) of the ray from the axis with the
-// triangles' intersection segments with the plane y; -1 where the ray meets nothing.
-std::vector<double> section_profile(const gdsr::TriMesh& b, const Vec3& axis, double y, double max_r, int bins) {
+// psi_k = 2 pi k / bins, the farthest (nearest: the nearest) crossing below max_r of the ray
+// from the axis with the triangles' intersection segments with the plane y; -1 where the ray
+// meets nothing.
+std::vector<double> section_profile(const gdsr::TriMesh& b, const Vec3& axis, double y, double max_r, int bins,
+                                    bool nearest = false) {
   std::vector<double> r(bins, -1.0);
   constexpr double kTwoPi = 6.283185307179586;
   for (int f = 0; f < b.F.rows(); ++f) {
@@ -51,7 +53,7 @@ std::vector<double> section_profile(const gdsr::TriMesh& b, const Vec3& axis, do
       if (std::abs(den) < 1e-15) continue;
       const double t = (pts[0].x() * e.y() - pts[0].y() * e.x()) / den;  // along the ray
       const double u = (pts[0].x() * d.y() - pts[0].y() * d.x()) / den;  // along the segment
-      if (u >= 0 && u <= 1 && t > 0 && t < max_r) r[k] = std::max(r[k], t);
+      if (u >= 0 && u <= 1 && t > 0 && t < max_r) r[k] = r[k] < 0 ? t : nearest ? std::min(r[k], t) : std::max(r[k], t);
     }
   }
   return r;
@@ -278,6 +280,11 @@ BodyLandmarks measure_body(const gdsr::TriMesh& b) {
   lm.bust_r = lm.waist_r;
   for (double y = lm.waist_y; y <= lm.armpit_y; y += 0.005 * s)
     lm.bust_r = std::max(lm.bust_r, radial_extent(b, lm.axis, y, slab, 0.24 * s));
+  // The trunk's own section under the armpits: the nearest crossing from the axis, so that arms
+  // hanging beside the trunk (within max_r) are not taken for it.
+  lm.bust_y = lm.armpit_y - 0.02 * s;
+  lm.bust_profile = section_profile(b, lm.axis, lm.bust_y, 0.24 * s, BodyLandmarks::kWaistBins, /*nearest=*/true);
+  for (double& r : lm.bust_profile) r = r > 0 ? std::min(r, lm.bust_r) : lm.bust_r;
   measure_legs(b, lm);
   measure_arms(b, lm);
   measure_upper_trunk(b, lm);
@@ -303,26 +310,42 @@ double waist_fit_shrink(const BodyLandmarks& lm, double psi, double below) {
 
 namespace {
 constexpr double kTwoPi = 6.283185307179586;
-
-// Radii (ease added) of the waist section at the profile's directions, and the arc lengths
-// of the closed polygon through them from direction 0 (size n + 1).
-void waist_polygon(const BodyLandmarks& lm, double ease, std::vector<double>& r, std::vector<double>& arc) {
-  const int n = lm.waist_profile.empty() ? BodyLandmarks::kWaistBins : static_cast<int>(lm.waist_profile.size());
-  r.resize(n);
-  for (int k = 0; k < n; ++k) r[k] = (lm.waist_profile.empty() ? lm.waist_r : lm.waist_profile[k]) + ease;
-  arc.assign(n + 1, 0.0);
-  for (int k = 0; k < n; ++k) {
-    const double p0 = kTwoPi * k / n, p1 = kTwoPi * (k + 1) / n;
-    const double q = r[(k + 1) % n];
-    arc[k + 1] = arc[k] + std::hypot(q * std::sin(p1) - r[k] * std::sin(p0), q * std::cos(p1) - r[k] * std::cos(p0));
-  }
-}
 }  // namespace
 
+SectionCurve::SectionCurve(const std::vector<double>& profile, double fallback_r, double ease) {
+  const int n = profile.empty() ? BodyLandmarks::kWaistBins : static_cast<int>(profile.size());
+  r_.resize(n);
+  for (int k = 0; k < n; ++k) r_[k] = (profile.empty() ? fallback_r : profile[k]) + ease;
+  arc_.assign(n + 1, 0.0);
+  for (int k = 0; k < n; ++k) {
+    const double p0 = kTwoPi * k / n, p1 = kTwoPi * (k + 1) / n;
+    const double q = r_[(k + 1) % n];
+    arc_[k + 1] =
+        arc_[k] + std::hypot(q * std::sin(p1) - r_[k] * std::sin(p0), q * std::cos(p1) - r_[k] * std::cos(p0));
+  }
+}
+
+double SectionCurve::radius(double psi) const {
+  const int n = static_cast<int>(r_.size());
+  double t = psi / kTwoPi * n;
+  t -= n * std::floor(t / n);
+  const int i = std::min(static_cast<int>(t), n - 1);
+  const double w = t - i;
+  return (1 - w) * r_[i] + w * r_[(i + 1) % n];
+}
+
+double SectionCurve::psi_at(double f) const {
+  const int n = static_cast<int>(r_.size());
+  const double s = (f - std::floor(f)) * arc_[n];
+  const int i =
+      std::clamp(static_cast<int>(std::upper_bound(arc_.begin(), arc_.end(), s) - arc_.begin()) - 1, 0, n - 1);
+  const double len = arc_[i + 1] - arc_[i];
+  const double w = len > 0 ? std::clamp((s - arc_[i]) / len, 0.0, 1.0) : 0.0;
+  return kTwoPi * (i + w) / n;
+}
+
 double waist_perimeter(const BodyLandmarks& lm, double ease) {
-  std::vector<double> r, arc;
-  waist_polygon(lm, ease, r, arc);
-  return arc.back();
+  return SectionCurve(lm.waist_profile, lm.waist_r, ease).perimeter();
 }
 
 WaistCurve::WaistCurve(const BodyLandmarks& lm, double a, double drop) {
@@ -336,27 +359,8 @@ WaistCurve::WaistCurve(const BodyLandmarks& lm, double a, double drop) {
     }
     ease_ = 0.5 * (lo + hi);
   }
-  waist_polygon(lm, ease_, r_, arc_);
+  static_cast<SectionCurve&>(*this) = SectionCurve(lm.waist_profile, lm.waist_r, ease_);
   drop_ = drop > 0 ? drop : std::max(lm.waist_y - lm.hip_y, 0.0);
-}
-
-double WaistCurve::radius(double psi) const {
-  const int n = static_cast<int>(r_.size());
-  double t = psi / kTwoPi * n;
-  t -= n * std::floor(t / n);
-  const int i = std::min(static_cast<int>(t), n - 1);
-  const double w = t - i;
-  return (1 - w) * r_[i] + w * r_[(i + 1) % n];
-}
-
-double WaistCurve::psi_at(double f) const {
-  const int n = static_cast<int>(r_.size());
-  const double s = (f - std::floor(f)) * arc_[n];
-  const int i =
-      std::clamp(static_cast<int>(std::upper_bound(arc_.begin(), arc_.end(), s) - arc_.begin()) - 1, 0, n - 1);
-  const double len = arc_[i + 1] - arc_[i];
-  const double w = len > 0 ? std::clamp((s - arc_[i]) / len, 0.0, 1.0) : 0.0;
-  return kTwoPi * (i + w) / n;
 }
 
 double WaistCurve::weight(double below) const {

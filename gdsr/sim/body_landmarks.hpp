@@ -22,6 +22,10 @@ struct BodyLandmarks {
   // psi_k = 2 pi k / kWaistBins. Never above waist_r.
   static constexpr int kWaistBins = 72;
   std::vector<double> waist_profile;
+  // The trunk's section at bust_y (2 cm under the armpits) the same way, its nearest crossing
+  // from the axis (arms beside the trunk left out); never above bust_r.
+  double bust_y = 0;
+  std::vector<double> bust_profile;
   // Bounding box of the trunk between hips and armpits (points within 0.26 m x H / 1.75 of the axis).
   gdsr::Vec3 trunk_lo = gdsr::Vec3::Zero(), trunk_hi = gdsr::Vec3::Zero();
   // Top of the shoulders between neck and shoulder joints, and the bounding box of the neck
@@ -55,18 +59,32 @@ double waist_radius(const BodyLandmarks& lm, double psi);
 // waist-to-hip drop), so the hips, which the garments clear with their ease, are untouched.
 double waist_fit_shrink(const BodyLandmarks& lm, double psi, double below);
 
+// A trunk section (a profile as waist_profile: radii from the axis at psi_k = 2 pi k / n)
+// grown outwards by an ease, walked by arc length: a band laid along it neither stretches nor
+// gathers. An empty profile stands for the circle of radius `fallback_r`.
+class SectionCurve {
+ public:
+  SectionCurve() = default;
+  SectionCurve(const std::vector<double>& profile, double fallback_r, double ease);
+  double radius(double psi) const;  // metres from the axis in direction psi (see waist_profile)
+  // Direction psi (radians, in [0, 2 pi)) of the point a fraction f of the perimeter round from
+  // the front (psi = 0) towards increasing psi; f wraps.
+  double psi_at(double f) const;
+  double perimeter() const { return arc_.back(); }  // metres
+
+ private:
+  std::vector<double> r_;         // m, radius at psi_k (ease included)
+  std::vector<double> arc_{0.0};  // m, arc length from psi_0 to psi_k, k = 0..n (arc_[n]: the perimeter)
+};
+
 // The waist section (waist_profile) grown outwards by an ease e until its perimeter is
 // 2 pi a, the length of a cone skirt's waistband of radius a: laid along it by arc length, the
 // waistband neither stretches nor gathers. Without a measured profile, the circle of radius a.
-class WaistCurve {
+class WaistCurve : public SectionCurve {
  public:
   // drop: metres under the waist over which the fit fades out (weight); <= 0: the waist-to-hip drop.
   WaistCurve(const BodyLandmarks& lm, double a, double drop = 0);
   double ease() const { return ease_; }  // metres (0 when even the bare section is longer than 2 pi a)
-  double radius(double psi) const;       // metres from the axis in direction psi (see waist_profile)
-  // Direction psi (radians, in [0, 2 pi)) of the point a fraction f of the perimeter round from
-  // the front (psi = 0) towards increasing psi; f wraps.
-  double psi_at(double f) const;
   // How much of the fit applies `below` metres under the waist: 1 - t^2, t = below / drop
   // clamped to [0, 1]. Where the section is wider than the cone (the sides) the skirt
   // stays out at least as far as the straight cone through the widest point; the smoothstep over
@@ -74,8 +92,6 @@ class WaistCurve {
   double weight(double below) const;
 
  private:
-  std::vector<double> r_;       // m, radius at psi_k = 2 pi k / n (ease included)
-  std::vector<double> arc_;     // m, arc length from psi_0 to psi_k, k = 0..n (arc_[n]: the perimeter)
   double ease_ = 0, drop_ = 0;  // m
 };
 
