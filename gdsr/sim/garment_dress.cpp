@@ -32,7 +32,6 @@ struct DressLayer {
   // rho1 (the waist, arc length W = pi R) and rho1 - Hb (the band, arc length Wt) around an
   // apex above the panel. rho1 = 0: a rectangle (the band as long as the waist).
   double rho1 = 0, theta = 0;
-  int n = 0;  // segments of the waist arc and of the band
 
   // Flat position of the point a fraction frac (-0.5 .. 0.5) across bodice panel k, h (0 .. 1) up it.
   Vec2 bodice_uv(int k, double frac, double h) const {
@@ -40,14 +39,11 @@ struct DressLayer {
     const double rho = rho1 - h * Hb, phi = frac * theta;
     return bodice_origin[k] + Vec2(rho * std::sin(phi), rho1 - rho * std::cos(phi));
   }
-  // uv lies on panel k's band (its top edge, a polyline through n + 1 points of the arc).
+  // uv lies on panel k's band: its chords of the arc of radius rho1 - Hb are the only points of
+  // the panel that close to the apex (as a cone skirt's pinned waistband).
   bool on_band(int k, const Vec2& uv) const {
-    for (int i = 0; i < n; ++i) {
-      const Vec2 a = bodice_uv(k, -0.5 + static_cast<double>(i) / n, 1), b = bodice_uv(k, -0.5 + (i + 1.0) / n, 1);
-      const double t = std::clamp((uv - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
-      if ((a + t * (b - a) - uv).norm() < 1e-9) return true;
-    }
-    return false;
+    if (rho1 == 0) return uv.y() - bodice_origin[k].y() > Hb - 1e-9;
+    return (uv - bodice_origin[k] - Vec2(0, rho1)).norm() < rho1 - Hb + 1e-9;
   }
   // The inverse of bodice_uv.
   void bodice_coords(int k, const Vec2& uv, double& frac, double& h) const {
@@ -70,7 +66,7 @@ int layer_of(int panel) { return (panel < 4 ? panel : panel - 4) / 2; }
 
 GarmentDesign design_dress_layered(const BodyLandmarks& lm) {
   const double s = lm.height / 1.75;
-  const double top_y = lm.armpit_y - 0.02 * s;
+  const double top_y = lm.bust_y;  // the band: 2 cm under the armpits, where bust_profile is measured
   const double drop = std::max(lm.waist_y - lm.hip_y, 0.02);
   GarmentDesign d;
   Pattern& p = d.pattern;
@@ -109,7 +105,7 @@ GarmentDesign design_dress_layered(const BodyLandmarks& lm) {
   for (int l = 0; l < 2; ++l) {
     DressLayer& L = (*layers)[l];
     const double W = kPi * L.R;
-    const int n = L.n = L.skirt.n_inner;
+    const int n = L.skirt.n_inner;
     for (int k = 0; k < 2; ++k) {
       L.bodice_origin[k] = Vec2(x0 + W / 2, y0);
       x0 += W + 0.05;
