@@ -65,6 +65,7 @@ struct MakeArgs {
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN, self_slack = NAN;
   double self_slack_per_pd = NAN;
   bool self_collision = true;
+  bool limbs_pass_through = true;
   bool independent_hr = false;  // settle HR from its own placement, not from the settled LR garment
   bool skip_built = false;      // keep --out when it already holds this clip, built and valid
   int rest_blend_frames = 15;
@@ -186,6 +187,7 @@ void run_make(const MakeArgs& a) {
   if (a.self_detect_every > 0) params.self_detect_every = a.self_detect_every;
   if (!std::isnan(a.compression_ratio)) params.compression_ratio = a.compression_ratio;
   params.self_collision = a.self_collision;
+  params.limbs_pass_through = a.limbs_pass_through;
   sim::Garment lr_garment = sim::make_garment(a.garment, a.lr_pd, body.rest_mesh());
   sim::Garment hr_garment = sim::make_garment(a.garment, a.hr_pd, body.rest_mesh());
   gdsr::Dataset d;
@@ -230,6 +232,7 @@ void run_make(const MakeArgs& a) {
                   {"hr_start", hr_start_name(a)},
                   {"rest_arm_drop_degrees", bo.rest_arm_drop_degrees},
                   {"self_collision", params.self_collision},
+                  {"limbs_pass_through", params.limbs_pass_through},
                   {"self_thickness_m", params.self_thickness},
                   {"self_thickness_per_pd", params.self_thickness_per_pd},
                   {"self_slack_m", params.self_slack},
@@ -622,6 +625,9 @@ void add_data_command(CLI::App& app) {
                    "frames of damped motion on the first pose before frame 0 (default: the solver's)")
       ->check(CLI::Range(0, 1000));
   make->add_flag("!--no-self-collision", mk->self_collision, "switch cloth self-collision off");
+  make->add_flag("!--no-limbs-pass-through", mk->limbs_pass_through,
+                 "keep body contacts around cloth that a hand went through, so the hand carries it (solver "
+                 "revision 10)");
   make->add_flag("--independent-hr", mk->independent_hr,
                  "settle the HR garment from its own placement instead of from the settled LR garment (solver "
                  "revision 3; the resolutions then start the clip with their folds in different places)");

@@ -239,6 +239,24 @@ void ClothSolver::place_pins(const Points3& body) {
   pins_.place(body, x_);
 }
 
+void ClothSolver::drop_part_contacts_around(const Contact& lost, std::vector<std::array<Contact, 2>>& found,
+                                            std::vector<signed char>& count) const {
+  const double sep2 = p_.pinch_separation * p_.pinch_separation;
+  const Vec3 part = bary_point(body_rest_, bodyF_, lost.face, lost.bary);
+  auto drop = [&](int u) {
+    int kept = 0;
+    for (int k = 0; k < count[u]; ++k)
+      if ((bary_point(body_rest_, bodyF_, found[u][k].face, found[u][k].bary) - part).squaredNorm() > sep2)
+        found[u][kept++] = found[u][k];
+    count[u] = static_cast<signed char>(kept);
+  };
+  drop(lost.v);
+  for (int k = vertex_edges_.offsets[lost.v]; k < vertex_edges_.offsets[lost.v + 1]; ++k) {
+    const Edge& e = edges_[vertex_edges_.items[k]];
+    drop(e.i == lost.v ? e.j : e.i);
+  }
+}
+
 void ClothSolver::refresh_contacts(const Points3& body_now) {
   contacts_.clear();
   const int nv = static_cast<int>(x_.rows());
@@ -249,6 +267,7 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
     // then gathered in vertex order, so the result does not depend on the thread count.
     std::vector<std::array<Contact, 2>> found(nv);
     std::vector<signed char> count(nv, 0);
+    std::vector<Contact> pierced(nv, Contact{-1, -1, Vec3::Zero()});  // per vertex: the part it is lost in
     auto add = [&](int v, const SurfaceHit& hit) {
       // Deeper than max_push: the vertex went through a thin part; pushing it out would tear
       // the cloth, so leave it.
@@ -260,14 +279,20 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
       const Vec3 x = x_.row(v).transpose();
       const SurfaceHit a = grid_.closest(x, body_now, r);
       if (a.face < 0) continue;
+      const Vec3 ra = bary_point(body_rest_, bodyF_, a.face, a.bary);
+      const bool dressed = home_.row(v).allFinite();
+      // Lost inside a part it was not dressed on (limbs_pass_through): a hand, not the leg a
+      // trouser leg hangs on.
+      if (a.signed_distance <= -p_.max_push && anchored_[v] &&
+          (!dressed || (ra - home_.row(v).transpose()).squaredNorm() > sep2))
+        pierced[v] = {v, a.face, a.bary};
       // A second body part within reach (far from the first one in the first pose): the cloth
       // may be pinched between them (a hand pressing a skirt onto the hip). Both contacts
       // apply; the part the vertex was dressed on comes last, so it wins when they conflict.
-      if (!home_.row(v).allFinite()) {  // dressed nowhere near the body: nothing to prefer
+      if (!dressed) {  // dressed nowhere near the body: nothing to prefer
         add(v, a);
         continue;
       }
-      const Vec3 ra = bary_point(body_rest_, bodyF_, a.face, a.bary);
       const SurfaceHit b = grid_.closest(x, body_now, r, [&](int f) {
         for (int k = 0; k < 3; ++k)
           if ((body_rest_.row(bodyF_(f, k)).transpose() - ra).squaredNorm() <= sep2) return false;
@@ -283,6 +308,9 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
       add(v, a_home ? b : a);
       add(v, a_home ? a : b);
     }
+    if (p_.limbs_pass_through)
+      for (const Contact& lost : pierced)
+        if (lost.v >= 0) drop_part_contacts_around(lost, found, count);
     for (int v = 0; v < nv; ++v)
       for (int k = 0; k < count[v]; ++k) contacts_.push_back(found[v][k]);
   }

@@ -26,6 +26,7 @@
 #include "gdsr/sim/cloth_tethers.hpp"
 #include "gdsr/sim/garments.hpp"
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -62,7 +63,12 @@ namespace sim {
 //    (BodyLandmarks::bust_profile): a round band stood 6-15 cm off the chest of CMU 01_01's body
 //    and the arms, hanging beside the trunk, went through it. Every other garment is unchanged,
 //    bit for bit.
-inline constexpr int kSolverRevision = 10;
+// 11: a hand that went through cloth hanging from a pin passes on (SimParams::limbs_pass_through)
+//    instead of wrapping the cloth around itself and carrying it: skirt_short on the CMU 131
+//    walks had a hand inside the skirt for most of the clip. Clips where no cloth vertex ever
+//    lies deeper than max_push inside a body part it was not dressed on, and garments without
+//    pins, are unchanged, bit for bit.
+inline constexpr int kSolverRevision = 11;
 
 struct SimParams {
   int substeps = 20;                // per body frame
@@ -99,6 +105,16 @@ struct SimParams {
                                          // hangs from a pin slips (it cannot follow a limb past its band); a garment
                                          // without pins is carried by the body: releasing let a rising arm pass through
                                          // the 10 mm t-shirt's sleeve on 61_02, and the shirt fell to the feet
+  bool limbs_pass_through = true;  // cloth that hangs from a pin and lies deeper than max_push inside a body part it
+                                   // was not dressed on (pinch_separation from its first-pose closest point: a hand
+                                   // went through it, see contact_release_stretch) makes no contact with that part,
+                                   // nor do its edge neighbours, until it is out. Otherwise the ring around it, pushed
+                                   // onto the hand and held there by friction, wrapped the hand and was carried with
+                                   // it: on CMU 131_01 (2-6 s) a walking hand dragged the 30 mm skirt_short from
+                                   // frame 44 to the end, 28 mm deep. A part the cloth was dressed on keeps its
+                                   // contacts: the garment hangs on it (a leg in a trouser leg), so letting that part
+                                   // through would drop the cloth off the body (on the walks and salsa clips measured,
+                                   // every vertex lost this deep was in a hand)
   double pinch_separation = 0.15;  // m: body points this far apart in the first pose are different parts (a hand
                                    // and a hip); cloth pinched between two parts stays on the part it was dressed on
   double max_speed = 15;                         // m/s, velocity clamp (safety against fast body parts)
@@ -154,6 +170,7 @@ class ClothSolver {
   int num_bends() const { return static_cast<int>(bends_.size()); }
   int num_tethers() const { return static_cast<int>(tethers_.size()); }
   int num_layer_pairs() const { return static_cast<int>(layer_pairs_.size()); }  // at the last contact refresh
+  int num_body_contacts() const { return static_cast<int>(contacts_.size()); }   // at the last contact refresh
   // Self-contact pairs and tangled vertices at the last detection (0 without self-collision).
   int num_self_pairs() const { return self_ ? self_->num_vertex_triangle() + self_->num_edge_edge() : 0; }
   int num_tangled_vertices() const { return self_ ? self_->num_tangled_vertices() : 0; }
@@ -182,6 +199,10 @@ class ClothSolver {
   };
 
   void refresh_contacts(const gdsr::Points3& body_now);
+  // Removes the contacts of `lost.v` and of its edge neighbours with the body part it is lost in
+  // (body points within pinch_separation of `lost`'s in the first pose); see limbs_pass_through.
+  void drop_part_contacts_around(const Contact& lost, std::vector<std::array<Contact, 2>>& found,
+                                 std::vector<signed char>& count) const;
   void place_pins(const gdsr::Points3& body);
   // The steps of one substep of length h (seconds), in the order step() runs them.
   void detect_self_contacts(double h);

@@ -205,7 +205,8 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
                                    "' --seconds 0.1 --lr-pd 0.08 --hr-pd 0.06 --rest-blend 2 --raster 64"
                                    " --iterations 3 --friction 0.1 --self-thickness 0.002 --no-self-collision"
                                    " --compression-ratio 0.5 --settle-frames 3 --contact-every 2"
-                                   " --self-slack 0.002 --self-detect-every 3 --self-slack-per-pd 0.25");
+                                   " --self-slack 0.002 --self-detect-every 3 --self-slack-per-pd 0.25"
+                                   " --no-limbs-pass-through");
   REQUIRE(mk.status == 0);
   const std::string manifest = gdsr_test::slurp(out + "/manifest.json");
   CHECK(manifest.find("\"iterations\": 3") != std::string::npos);
@@ -218,6 +219,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"self_slack_m\": 0.002") != std::string::npos);
   CHECK(manifest.find("\"self_detect_every\": 3") != std::string::npos);
   CHECK(manifest.find("\"self_slack_per_pd\": 0.25") != std::string::npos);
+  CHECK(manifest.find("\"limbs_pass_through\": false") != std::string::npos);
   for (const std::string bad : {"--iterations 0", "--friction -1", "--self-thickness 1", "--bend-stiffness -2",
                                 "--compression-ratio 0", "--settle-frames -1", "--contact-every 0",
                                 "--self-slack 0", "--self-detect-every 0", "--self-slack-per-pd 0"}) {
