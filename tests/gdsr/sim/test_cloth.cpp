@@ -154,17 +154,34 @@ TEST_CASE("cloth: cloth pinched between a hand and the torso stays on the torso"
 }
 
 namespace {
+// A 30 mm garment simulated on `seconds` of a motion file from `start` seconds, put on the rest
+// pose the garment catalogue says it is cut for.
+struct GarmentRun {
+  gdsr::BodySequence body;
+  sim::Garment garment;
+  std::vector<Points3> frames;
+};
+GarmentRun run_on_clip(const std::string& garment, const std::string& bvh, double start, double seconds,
+                       const sim::SimParams& p = {}) {
+  REQUIRE_MESSAGE(std::ifstream(bvh).good(), bvh << " is missing (../shared beside the repository)");
+  gdsr::BodyOptions opt;
+  opt.start_seconds = start;
+  opt.max_seconds = seconds;
+  opt.rest_arm_drop_degrees = sim::rest_arm_drop_degrees(garment);
+  GarmentRun r{gdsr::load_body_sequence(bvh, opt), {}, {}};
+  r.garment = sim::make_garment(garment, 0.03, r.body.rest_mesh());
+  r.frames = sim::simulate(r.garment, r.body, p);
+  return r;
+}
+
 // Largest edge length over its pattern length, over every frame of the 30 mm skirt on CMU
 // salsa 61_02 from 3.5 s for 1.2 s (a hand sweeps past the pinned waistband at ~4.5 s).
 double salsa_hand_sweep_stretch(const std::string& bvh, double release_stretch) {
-  gdsr::BodyOptions opt;
-  opt.start_seconds = 3.5;
-  opt.max_seconds = 1.2;
-  const auto body = gdsr::load_body_sequence(bvh, opt);
-  const auto g = sim::make_garment("skirt_short", 0.03, body.rest_mesh());
   sim::SimParams p;
   p.contact_release_stretch = release_stretch;
-  const auto out = sim::simulate(g, body, p);
+  const GarmentRun run = run_on_clip("skirt_short", bvh, 3.5, 1.2, p);
+  const auto& g = run.garment;
+  const auto& out = run.frames;
   double worst = 0;
   for (const Points3& X : out) {
     REQUIRE(X.allFinite());
@@ -245,19 +262,15 @@ namespace {
 // CMU 131_01 from 2 s for 2 s (76 frames with the rest blend): a swinging hand goes into the
 // skirt at frame 20 and has passed it by frame 40.
 int walking_hand_deep_frames_at_end(const std::string& bvh, bool limbs_pass_through) {
-  gdsr::BodyOptions opt;
-  opt.start_seconds = 2;
-  opt.max_seconds = 2;
-  const auto body = gdsr::load_body_sequence(bvh, opt);
-  const auto g = sim::make_garment("skirt_short", 0.03, body.rest_mesh());
   sim::SimParams p;
   p.limbs_pass_through = limbs_pass_through;
-  const auto out = sim::simulate(g, body, p);
-  REQUIRE(out.size() == 76);
+  const GarmentRun run = run_on_clip("skirt_short", bvh, 2, 2, p);
+  REQUIRE(run.frames.size() == 76);
   int deep = 0;
-  for (size_t t = 0; t < out.size(); ++t) {
-    REQUIRE(out[t].allFinite());
-    if (t >= out.size() - 20) deep += sim::body_penetration(out[t], body.F, body.frames[t], 0.2).max_depth > 0.005;
+  for (size_t t = 0; t < run.frames.size(); ++t) {
+    REQUIRE(run.frames[t].allFinite());
+    if (t >= run.frames.size() - 20)
+      deep += sim::body_penetration(run.frames[t], run.body.F, run.body.frames[t], 0.2).max_depth > 0.005;
   }
   return deep;
 }
@@ -281,24 +294,10 @@ TEST_CASE("cloth: a hand that went through the pinned skirt passes on instead of
 
 namespace {
 
-// The 30 mm t-shirt on 1 s (from 2 s) of a CMU salsa clip, put on the rest pose it is cut for.
-struct TshirtRun {
-  gdsr::BodySequence body;
-  sim::Garment garment;
-  std::vector<gdsr::Points3> frames;
-};
-TshirtRun tshirt_on_salsa(const std::string& clip) {
-  const std::string bvh = std::string(GDSR_SHARED_DIR) + "/motions/cmu-salsa/" + clip + ".bvh";
-  REQUIRE_MESSAGE(std::ifstream(bvh).good(), bvh << " is missing (../shared beside the repository)");
-  gdsr::BodyOptions opt;
-  opt.start_seconds = 2;
-  opt.max_seconds = 1;
-  opt.rest_arm_drop_degrees = sim::rest_arm_drop_degrees("tshirt");
-  REQUIRE(opt.rest_arm_drop_degrees == 45);
-  TshirtRun r{gdsr::load_body_sequence(bvh, opt), {}, {}};
-  r.garment = sim::make_garment("tshirt", 0.03, r.body.rest_mesh());
-  r.frames = sim::simulate(r.garment, r.body, sim::SimParams{});
-  return r;
+// The 30 mm t-shirt on 1 s (from 2 s) of a CMU salsa clip, put on the A-pose it is cut for.
+GarmentRun tshirt_on_salsa(const std::string& clip) {
+  REQUIRE(sim::rest_arm_drop_degrees("tshirt") == 45);
+  return run_on_clip("tshirt", std::string(GDSR_SHARED_DIR) + "/motions/cmu-salsa/" + clip + ".bvh", 2, 1);
 }
 
 }  // namespace
@@ -309,7 +308,7 @@ TEST_CASE("cloth: a garment without pins is carried by the arms it is worn on") 
   // frames had cloth more than 5 mm inside the body, and at 10 mm the shirt fell to the feet.
   // Carried by the body, 3 frames of 46 did on the T-pose cut and 5 do on the A-pose cut
   // (a handful: the hand reaches the hip).
-  const TshirtRun run = tshirt_on_salsa("61_02");
+  const GarmentRun run = tshirt_on_salsa("61_02");
   const auto& body = run.body;
   const auto& out = run.frames;
   REQUIRE(run.garment.pinned.empty());
@@ -330,7 +329,7 @@ TEST_CASE("cloth: a t-shirt stays on a salsa dancer's shoulders and arms") {
   // definitions). Cut for an A-pose with tapered sleeves: every wrist within 4-6 cm of its
   // sleeve, and 0-12 such frames over small changes of the setup (the arms reach forward and
   // pull the back of the loose shirt off the shoulder blades for a moment).
-  const TshirtRun run = tshirt_on_salsa("60_02");
+  const GarmentRun run = tshirt_on_salsa("60_02");
   const auto& body = run.body;
   const auto& out = run.frames;
   const gdsr::Points3& B0 = body.frames[0];
