@@ -157,6 +157,8 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
       r.strain.E_u += e.E_u / T;
       r.strain.E_v += e.E_v / T;
       r.strain.E_uv += e.E_uv / T;
+      r.strain.E_u_stretched += e.E_u_stretched / T;
+      r.strain.E_v_stretched += e.E_v_stretched / T;
       const double stretch = max_edge_stretch(g, X);
       r.torn_frames += stretch > opt.tear_stretch;
       if (stretch > r.max_edge_stretch || r.max_edge_stretch_frame < 0) {
@@ -215,6 +217,8 @@ nlohmann::json resolution_json(const ResolutionValidity& r, bool body) {
                        {{"E_u", r.strain.E_u},
                         {"E_v", r.strain.E_v},
                         {"E_uv", r.strain.E_uv},
+                        {"E_u_stretched", r.strain.E_u_stretched},
+                        {"E_v_stretched", r.strain.E_v_stretched},
                         {"max_edge_stretch", r.max_edge_stretch},
                         {"max_edge_stretch_frame", r.max_edge_stretch_frame},
                         {"torn_frames", r.torn_frames}}},
@@ -256,6 +260,10 @@ ResolutionValidity resolution_from_json(const nlohmann::json& j, bool body, cons
   r.strain.E_u = take<double>(st, "E_u", where + "strain.");
   r.strain.E_v = take<double>(st, "E_v", where + "strain.");
   r.strain.E_uv = take<double>(st, "E_uv", where + "strain.");
+  // Manifests written before E_u was split: not measured.
+  const bool split = st.contains("E_u_stretched");
+  r.strain.E_u_stretched = split ? take<double>(st, "E_u_stretched", where + "strain.") : std::numeric_limits<double>::quiet_NaN();
+  r.strain.E_v_stretched = split ? take<double>(st, "E_v_stretched", where + "strain.") : std::numeric_limits<double>::quiet_NaN();
   // Manifests written before torn cloth was counted: not measured.
   if (st.contains("torn_frames")) {
     r.max_edge_stretch = take<double>(st, "max_edge_stretch", where + "strain.");
@@ -357,6 +365,12 @@ std::string validity_table(const ValidityFigures& v) {
        ratio_str(v.strain_ratio_v()).c_str());
   line("  %-40s %14.5f %14.5f %9s\n", "strain: mean E_uv", v.lr.strain.E_uv, v.hr.strain.E_uv,
        ratio_str(v.strain_ratio_uv()).c_str());
+  if (!std::isnan(v.lr.strain.E_u_stretched) && !std::isnan(v.hr.strain.E_u_stretched)) {
+    line("  %-40s %14.5f %14.5f %9s\n", "  of E_u: stretched fibres", v.lr.strain.E_u_stretched,
+         v.hr.strain.E_u_stretched, ratio_str(ratio(v.hr.strain.E_u_stretched, v.lr.strain.E_u_stretched)).c_str());
+    line("  %-40s %14.5f %14.5f %9s\n", "  of E_v: stretched fibres", v.lr.strain.E_v_stretched,
+         v.hr.strain.E_v_stretched, ratio_str(ratio(v.hr.strain.E_v_stretched, v.lr.strain.E_v_stretched)).c_str());
+  }
   if (v.lr.torn_frames >= 0 && v.hr.torn_frames >= 0) {
     auto longest = [](const ResolutionValidity& r) {
       char b[48];

@@ -46,12 +46,16 @@ StrainEnergies strain_energies(const GarmentMesh& g, const Points3& X) {
     s.E_u += (lu - 1) * (lu - 1);
     s.E_v += (lv - 1) * (lv - 1);
     s.E_uv += d * d;
+    s.E_u_stretched += lu > 1 ? (lu - 1) * (lu - 1) : 0.0;
+    s.E_v_stretched += lv > 1 ? (lv - 1) * (lv - 1) : 0.0;
     ++n;
   }
   if (n > 0) {
     s.E_u /= n;
     s.E_v /= n;
     s.E_uv /= n;
+    s.E_u_stretched /= n;
+    s.E_v_stretched /= n;
   }
   return s;
 }

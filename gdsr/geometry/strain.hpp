@@ -3,7 +3,9 @@
 // (metres), and
 //   E_u = (|w_u| - 1)^2,  E_v = (|w_v| - 1)^2,  E_uv = (w_u . w_v)^2   (dimensionless),
 // averaged over triangles. The one implementation used by the simulator's metrics and by
-// `gdsr eval`, so their figures agree.
+// `gdsr eval`, so their figures agree. E_u and E_v are split by the sign of |w| - 1 into the
+// stretched part (fibres longer than in the pattern, resisted by the fabric's stretch
+// stiffness) and the compressed part (shorter: how a mesh takes up folds finer than itself).
 #pragma once
 
 #include "gdsr/geometry/mesh.hpp"
@@ -12,6 +14,8 @@ namespace gdsr {
 
 struct StrainEnergies {
   double E_u = 0, E_v = 0, E_uv = 0;  // means over triangles (dimensionless)
+  // The stretched part of E_u and E_v: means of max(|w_u| - 1, 0)^2, max(|w_v| - 1, 0)^2.
+  double E_u_stretched = 0, E_v_stretched = 0;
 };
 
 // X: positions of g's welded vertices (V x 3, metres), triangles g.F with UV triangles g.FUV.

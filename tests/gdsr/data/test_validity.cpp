@@ -74,6 +74,7 @@ TEST_CASE("gdsr: validity figures of a stretched, lifted sheet over a rising box
     CHECK(r->si_clean_fraction() == 1.0);
     CHECK(r->si_max_pairs == 0);
     CHECK(r->strain.E_u == doctest::Approx(0.01).epsilon(1e-9));
+    CHECK(r->strain.E_u_stretched == doctest::Approx(0.01).epsilon(1e-9));  // stretched, not shortened
     CHECK(std::abs(r->strain.E_v) < 1e-15);
     CHECK(std::abs(r->strain.E_uv) < 1e-15);
     CHECK(std::abs(r->mean_curvature) < 1e-12);
@@ -240,6 +241,14 @@ TEST_CASE("gdsr: validity wrinkles: HR ripples above LR upsampled / figures surv
   CHECK(gdsr::validity_to_json(r) == gdsr::validity_to_json(v));
   CHECK(r.hr.si_frames == 5);
   CHECK(r.agreement_mean == v.agreement_mean);
+  CHECK(gdsr::validity_table(r).find("of E_u: stretched fibres") != std::string::npos);
+  // Figures written before E_u was split read NaN and print no split.
+  nlohmann::json unsplit = w.manifest.validity;
+  for (const char* res : {"lr", "hr"})
+    for (const char* k : {"E_u_stretched", "E_v_stretched"}) unsplit[res]["strain"].erase(k);
+  const gdsr::ValidityFigures u = gdsr::validity_from_json(unsplit);
+  CHECK(std::isnan(u.hr.strain.E_u_stretched));
+  CHECK(gdsr::validity_table(u).find("stretched fibres") == std::string::npos);
   // A dataset written without figures (as before this field existed) loads with none.
   gdsr::write_dataset(dir / "old", d);
   CHECK(gdsr::load_dataset(dir / "old").manifest.validity.empty());

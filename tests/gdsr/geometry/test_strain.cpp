@@ -20,6 +20,24 @@ TEST_CASE("strain energies: zero for the flat rest sheet, (s - 1)^2 for a unifor
   CHECK(st.E_v == doctest::Approx(0).epsilon(1e-12));
 }
 
+TEST_CASE("strain energies: the stretched part of E_u and E_v counts only fibres longer than the pattern") {
+  // x stretched by 1.5 and y shortened to 0.8: E_u = 0.25 all stretched, E_v = 0.04 all
+  // compressed; then y stretched by 1.2 instead: E_v = 0.04 all stretched.
+  const gdsr::GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec(3, 3, 0.2, 0.2));
+  gdsr::Points3 s = g.V;
+  s.col(0) *= 1.5;
+  s.col(1) *= 0.8;
+  const gdsr::StrainEnergies a = gdsr::strain_energies(g, s);
+  CHECK(a.E_u == doctest::Approx(0.25));
+  CHECK(a.E_u_stretched == doctest::Approx(0.25));
+  CHECK(a.E_v == doctest::Approx(0.04));
+  CHECK(a.E_v_stretched == doctest::Approx(0).epsilon(1e-12));
+  s.col(1) *= 1.2 / 0.8;
+  const gdsr::StrainEnergies b = gdsr::strain_energies(g, s);
+  CHECK(b.E_v_stretched == doctest::Approx(0.04));
+  CHECK(b.E_v == doctest::Approx(0.04));
+}
+
 TEST_CASE("strain energies: shear (w_u . w_v)^2 of a simple shear / degenerate UV triangles left out") {
   gdsr::GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec(3, 3, 0.2, 0.2));
   gdsr::Points3 s = g.V;
