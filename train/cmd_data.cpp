@@ -63,7 +63,7 @@ struct MakeArgs {
   // Solver knobs (NaN / <0: the solver's default, sim::SimParams).
   int iterations = -1, stretch_passes = -1, settle_frames = -1, contact_every = -1, self_detect_every = -1;
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN, self_slack = NAN;
-  double self_slack_per_pd = NAN;
+  double self_slack_per_pd = NAN, untangle_step = NAN;
   bool self_collision = true;
   bool limbs_pass_through = true;
   bool independent_hr = false;  // settle HR from its own placement, not from the settled LR garment
@@ -186,6 +186,7 @@ void run_make(const MakeArgs& a) {
   if (!std::isnan(a.self_slack_per_pd)) params.self_slack_per_pd = a.self_slack_per_pd;
   if (a.self_detect_every > 0) params.self_detect_every = a.self_detect_every;
   if (!std::isnan(a.compression_ratio)) params.compression_ratio = a.compression_ratio;
+  if (!std::isnan(a.untangle_step)) params.untangle_step = a.untangle_step;
   params.self_collision = a.self_collision;
   params.limbs_pass_through = a.limbs_pass_through;
   sim::Garment lr_garment = sim::make_garment(a.garment, a.lr_pd, body.rest_mesh());
@@ -238,6 +239,7 @@ void run_make(const MakeArgs& a) {
                   {"self_slack_m", params.self_slack},
                   {"self_slack_per_pd", params.self_slack_per_pd},
                   {"self_detect_every", params.self_detect_every},
+                  {"untangle_step", params.untangle_step},
                   {"compression_ratio", params.compression_ratio},
                   {"compression_pd_ref_m", params.compression_pd_ref},
                   {"clip_start_s", a.start},
@@ -495,6 +497,7 @@ void run_import(const ImportArgs& a) {
 
 struct CheckArgs {
   std::string data;
+  std::string per_frame;  // non-empty: write each frame's figures to this CSV
   int intersection_stride = kDefaultIntersectionStride;
   bool body = true;
 };
@@ -542,6 +545,10 @@ void run_check(const CheckArgs& a) {
     const gdsr::ValidityFigures v = measure(d, vo, seconds);
     std::printf("%s", gdsr::validity_table(v).c_str());
     std::printf("  (validity figures: %.1f s)\n", seconds);
+    if (!a.per_frame.empty()) {
+      gdsr::write_text_atomic(a.per_frame, gdsr::validity_per_frame_csv(v));
+      std::printf("  per-frame figures: %s\n", a.per_frame.c_str());
+    }
     if (m.validity.empty()) {
       std::printf("  manifest: no validity figures stored\n");
     } else {
@@ -618,6 +625,10 @@ void add_data_command(CLI::App& app) {
                    "in-plane compression stiffness / stretch stiffness at a 10 mm particle distance, scaled by (0.01 m "
                    "/ pd)^2 (default: the solver's)")
       ->check(finite_range(1e-4, 1.0));
+  make->add_option("--untangle-step", mk->untangle_step,
+                   "per substep, the most cloth that went through itself is moved to undo it, in self-thicknesses "
+                   "(default: the solver's; 0: off, as before solver revision 12)")
+      ->check(finite_range(0.0, 1.0));
   make->add_option("--contact-every", mk->contact_every,
                    "substeps between body contact refreshes (default: the solver's)")
       ->check(CLI::Range(1, 1000));
@@ -698,6 +709,8 @@ void add_data_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   ch->add_flag("!--no-body", chk->body, "do not measure the body penetration");
+  ch->add_option("--per-frame", chk->per_frame,
+                 "also write each frame's figures to this CSV (intersecting pairs, depth outside pinches, agreement)");
   ch->callback([chk]() { run_check(*chk); });
 
   add_data_compare_command(*data);

@@ -30,7 +30,9 @@ double median(std::vector<long> v) {
 
 // Self-intersection figures of one resolution over the checked frames (frames in parallel:
 // each CGAL call is independent).
-void measure_intersections(const std::vector<Points3>& frames, const Faces& F, int stride, ResolutionValidity& r) {
+// pairs_of(t): where frame t's pair count goes.
+template <class PairsOf> void measure_intersections(const std::vector<Points3>& frames, const Faces& F, int stride,
+                                                    ResolutionValidity& r, PairsOf pairs_of) {
   const int T = static_cast<int>(frames.size());
   std::vector<int> checked;
   for (int t = 0; t < T; t += stride) checked.push_back(t);
@@ -50,6 +52,7 @@ void measure_intersections(const std::vector<Points3>& frames, const Faces& F, i
   r.si_frames = static_cast<int>(checked.size());
   for (size_t k = 0; k < checked.size(); ++k) {
     pairs.push_back(si[k].pairs);
+    pairs_of(checked[k]) = si[k].pairs;
     r.si_clean_frames += si[k].pairs == 0;
     if (si[k].pairs > r.si_max_pairs || r.si_max_frame < 0) {
       r.si_max_pairs = si[k].pairs;
@@ -127,6 +130,18 @@ double mean_distance(const Points3& a, const Points3& b) {
 
 }  // namespace
 
+std::string validity_per_frame_csv(const ValidityFigures& v) {
+  std::string s = "frame,lr_pairs,hr_pairs,lr_depth_outside_pinches_mm,hr_depth_outside_pinches_mm,agreement_mm\n";
+  char buf[160];
+  for (size_t t = 0; t < v.per_frame.size(); ++t) {
+    const FrameValidity& f = v.per_frame[t];
+    std::snprintf(buf, sizeof buf, "%zu,%ld,%ld,%.2f,%.2f,%.2f\n", t, f.lr_pairs, f.hr_pairs, 1e3 * f.lr_depth,
+                  1e3 * f.hr_depth, 1e3 * f.agreement);
+    s += buf;
+  }
+  return s;
+}
+
 double ValidityFigures::strain_ratio_u() const { return ratio(hr.strain.E_u, lr.strain.E_u); }
 double ValidityFigures::strain_ratio_v() const { return ratio(hr.strain.E_v, lr.strain.E_v); }
 double ValidityFigures::strain_ratio_uv() const { return ratio(hr.strain.E_uv, lr.strain.E_uv); }
@@ -148,6 +163,7 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
   v.hr.faces = static_cast<int>(d.hr.F.rows());
   v.body_measured = opt.body && d.has_body();
   v.agreement_rest = mean_distance(d.hr.V, upsample(d.corr, d.lr.V));
+  v.per_frame.assign(T, FrameValidity{});
 
   const int steps = T + 2;  // the per-frame figures, then the LR and the HR self-intersections
   std::unique_ptr<BodyQuery> body;
@@ -172,6 +188,7 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
     const Points3 up = upsample(d.corr, d.lr_frames[t]);
     v.upsampled_mean_curvature += wrinkle_measure(up, d.hr.F).mean_curvature / T;
     const double agree = mean_distance(d.hr_frames[t], up);
+    v.per_frame[t].agreement = agree;
     v.agreement_mean += agree / T;
     if (agree > v.agreement_max || v.agreement_max_frame < 0) {
       v.agreement_max = agree;
@@ -186,14 +203,20 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
       const Points3& rest = d.body_frames[0];
       const bool crossing = body_crosses_itself(d.body_frames[t], d.body_faces, rest, opt.pinch_separation);
       v.body_crossing_frames += crossing;
-      add_penetration(penetration(*body, rest, d.lr_frames[t], opt), t, opt.penetration_limit, crossing, v.lr);
-      add_penetration(penetration(*body, rest, d.hr_frames[t], opt), t, opt.penetration_limit, crossing, v.hr);
+      const Depths lr = penetration(*body, rest, d.lr_frames[t], opt),
+                   hr = penetration(*body, rest, d.hr_frames[t], opt);
+      add_penetration(lr, t, opt.penetration_limit, crossing, v.lr);
+      add_penetration(hr, t, opt.penetration_limit, crossing, v.hr);
+      v.per_frame[t].lr_depth = lr.free;
+      v.per_frame[t].hr_depth = hr.free;
     }
     if (progress) progress(t + 1, steps);
   }
-  measure_intersections(d.lr_frames, d.lr.F, opt.intersection_stride, v.lr);
+  measure_intersections(d.lr_frames, d.lr.F, opt.intersection_stride, v.lr,
+                        [&](int t) -> long& { return v.per_frame[t].lr_pairs; });
   if (progress) progress(T + 1, steps);
-  measure_intersections(d.hr_frames, d.hr.F, opt.intersection_stride, v.hr);
+  measure_intersections(d.hr_frames, d.hr.F, opt.intersection_stride, v.hr,
+                        [&](int t) -> long& { return v.per_frame[t].hr_pairs; });
   if (progress) progress(steps, steps);
   return v;
 }

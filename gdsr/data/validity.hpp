@@ -31,6 +31,7 @@
 #include <nlohmann/json.hpp>
 
 #include <string>
+#include <vector>
 
 namespace gdsr {
 
@@ -73,6 +74,13 @@ struct ResolutionValidity {
   double mean_curvature = 0;       // 1/m, mean over frames
 };
 
+// One frame's figures (ValidityFigures::per_frame; not stored in the manifest).
+struct FrameValidity {
+  long lr_pairs = -1, hr_pairs = -1;  // intersecting triangle pairs (-1: frame not checked, see the stride)
+  double lr_depth = 0, hr_depth = 0;  // metres, deepest vertex under the body surface outside pinches (0: none)
+  double agreement = 0;               // metres, mean |HR - upsampled LR|
+};
+
 struct ValidityFigures {
   int frames = 0;
   int intersection_stride = 1;
@@ -87,6 +95,7 @@ struct ValidityFigures {
   int agreement_max_frame = -1;
   double agreement_rest = 0;            // the same on the canonical (rest) meshes
   double upsampled_mean_curvature = 0;  // 1/m, LR upsampled to HR topology, mean over frames
+  std::vector<FrameValidity> per_frame;  // the figures of each frame (not in the manifest)
   // HR / LR of a strain figure (NaN when LR's is below 1e-12)
   double strain_ratio_u() const;
   double strain_ratio_v() const;
@@ -96,6 +105,11 @@ struct ValidityFigures {
 // Computes every figure from the dataset (frames must be loaded). Throws gdsr::Error on a
 // dataset without frames or a stride < 1. progress(done, total) counts frames.
 ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt = {}, const ProgressFn& progress = {});
+
+// The per-frame figures as CSV text: a header, then one line per frame (frame, LR and HR
+// intersecting pairs with -1 for unchecked frames, LR and HR depth outside pinches in mm,
+// agreement in mm).
+std::string validity_per_frame_csv(const ValidityFigures& v);
 
 // The manifest's "validity" object (docs/dataset-format.md) and back; from_json throws
 // gdsr::Error naming the missing key.

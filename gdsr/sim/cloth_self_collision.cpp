@@ -253,7 +253,13 @@ SelfCollision::SelfCollision(const gdsr::Faces& F, int num_vertices) : F_(F), em
     for (int k = 0; k < 3; ++k) {
       const int i = F(f, k), j = F(f, (k + 1) % 3);
       const auto key = std::make_pair(std::min(i, j), std::max(i, j));
-      if (ids.emplace(key, static_cast<int>(edges_.size())).second) edges_.push_back({key.first, key.second});
+      const auto [it, added] = ids.emplace(key, static_cast<int>(edges_.size()));
+      if (added) {
+        edges_.push_back({key.first, key.second});
+        edge_faces_.push_back({f, -1});
+      } else {
+        edge_faces_[it->second][1] = f;
+      }
     }
   tangled_.assign(num_vertices, 0);
   // One broad-phase thread: Embree's own (TBB) threads beside the narrow phase's OpenMP ones
@@ -278,6 +284,7 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
   if (tangle_test) {
     std::fill(tangled_.begin(), tangled_.end(), 0);
     intersecting_ = 0;
+    crossings_.clear();
   }
   if (nf < 2) return;
   ++detections_;
@@ -415,9 +422,60 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     if (ef_cross[k]) {
       ++intersecting_;
       const int e = ef[k].first, f = ef[k].second;
+      crossings_.push_back({e, f});
       tangled_[edges_[e][0]] = tangled_[edges_[e][1]] = 1;
       for (int i = 0; i < 3; ++i) tangled_[F_(f, i)] = 1;
     }
+  std::sort(crossings_.begin(), crossings_.end());  // the broad phase's order is not fixed
+}
+
+int SelfCollision::untangle(Points3& x, const std::vector<double>& winv, double step) {
+  if (crossings_.empty()) return 0;
+  untangle_move_.assign(x.rows(), Vec3::Zero());
+  int crossing = 0;
+  for (const auto& [e, f] : crossings_) {
+    const int i0 = edges_[e][0], i1 = edges_[e][1];
+    const Vec3 p = x.row(i0), q = x.row(i1), a = x.row(F_(f, 0)), b = x.row(F_(f, 1)), c = x.row(F_(f, 2));
+    if (!segment_crosses_triangle(p, q, a, b, c)) continue;
+    ++crossing;
+    // Moving the edge's side by d against the face slides the crossing point P along the
+    // edge (unit E) to stay in the face's plane (unit normal N): dP = d - E (d.N) / (E.N).
+    // From P the contour runs into each face of the edge along R (its plane meets the
+    // face's along N x M, M its normal; R points into it), so the contour's length changes
+    // by -sum R.dP = -d . sum (R - N (E.R) / (E.N)): that sum is the descent direction.
+    const Vec3 E = (q - p).normalized(), N = (b - a).cross(c - a).normalized();
+    const double EN = E.dot(N);
+    if (!(std::abs(EN) > 1e-3)) continue;
+    Vec3 d = Vec3::Zero();
+    for (int g : edge_faces_[e]) {
+      if (g < 0) continue;
+      int o = F_(g, 0);
+      for (int k = 0; k < 3; ++k)
+        if (F_(g, k) != i0 && F_(g, k) != i1) o = F_(g, k);
+      const Vec3 ga = x.row(F_(g, 0)), gb = x.row(F_(g, 1)), gc = x.row(F_(g, 2));
+      Vec3 R = N.cross((gb - ga).cross(gc - ga));
+      if (!(R.norm() > 1e-12)) continue;
+      R.normalize();
+      Vec3 in = x.row(o).transpose() - p;
+      in -= in.dot(E) * E;
+      if (R.dot(in) < 0) R = -R;
+      d += R - N * (E.dot(R) / EN);
+    }
+    if (!(d.norm() > 1e-12)) continue;
+    d.normalize();
+    const double we = 0.5 * (winv[i0] + winv[i1]), wf = (winv[F_(f, 0)] + winv[F_(f, 1)] + winv[F_(f, 2)]) / 3;
+    if (!(we + wf > 0)) continue;
+    const Vec3 de = d * (step * we / (we + wf)), df = -d * (step * wf / (we + wf));
+    for (int i : {i0, i1})
+      if (winv[i] > 0) untangle_move_[i] += de;
+    for (int k = 0; k < 3; ++k)
+      if (winv[F_(f, k)] > 0) untangle_move_[F_(f, k)] += df;
+  }
+  for (long v = 0; v < x.rows(); ++v) {
+    const double len = untangle_move_[v].norm();
+    if (len > 0) x.row(v) += (len > step ? untangle_move_[v] * (step / len) : untangle_move_[v]).transpose();
+  }
+  return crossing;
 }
 
 int SelfCollision::project(Points3& x, const std::vector<double>& winv, double thickness) {

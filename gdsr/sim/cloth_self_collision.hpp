@@ -20,6 +20,10 @@
 // deeper on the wrong side than their motion since the detection can explain, get no
 // constraint, and their side follows the geometry, so an intersection is never locked in:
 // stretch and bending pull the layers apart and the pair is guarded again once free.
+// untangle() also moves them apart actively: each edge still crossing a face is moved against
+// it down the gradient of the intersection contour's length (Volino and Magnenat-Thalmann
+// 2006, "Resolving surface collisions through intersection contour minimization"), so a
+// closed contour shrinks to nothing and the part poking through goes back.
 //
 // Pairs sharing a vertex are skipped (the mesh's own stretch and bending act there).
 //
@@ -57,6 +61,12 @@ class SelfCollision {
   // (0 = fixed). Returns the number of pairs that were pushed.
   int project(gdsr::Points3& x, const std::vector<double>& winv, double thickness);
 
+  // One step of intersection contour minimisation over the edge-face crossings of the last
+  // tangle test that still cross in x: the edge and the face are moved apart (by inverse
+  // masses winv) along the direction that shortens the contour, no vertex by more than
+  // `step` metres. Returns the number of crossings that were still crossing.
+  int untangle(gdsr::Points3& x, const std::vector<double>& winv, double step);
+
   int num_vertex_triangle() const { return static_cast<int>(vt_.size()); }
   int num_edge_edge() const { return static_cast<int>(ee_.size()); }
   // Vertices of edges and triangles found crossing each other at the last tangle test.
@@ -87,6 +97,9 @@ class SelfCollision {
   };
   gdsr::Faces F_;
   std::vector<std::array<int, 2>> edges_;  // unique edges (i < j)
+  std::vector<std::array<int, 2>> edge_faces_;  // the (one or two) faces of each edge, -1: none
+  std::vector<std::array<int, 2>> crossings_;   // (edge, face) crossing at the last tangle test, sorted
+  std::vector<gdsr::Vec3> untangle_move_;       // per vertex, scratch of untangle()
   std::vector<VT> vt_;
   std::vector<EE> ee_;
   std::vector<char> tangled_;

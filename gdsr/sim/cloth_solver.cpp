@@ -562,6 +562,7 @@ void ClothSolver::step(const Points3& body_from, const Points3& body_to, double 
     std::fill(lambda_e.begin(), lambda_e.end(), 0.0);
     classify_edges();
     std::fill(lambda_b.begin(), lambda_b.end(), 0.0);
+    if (self_ && p_.untangle_step > 0) self_->untangle(x_, winv_, p_.untangle_step * p_.self_thickness);
     for (int it = 0; it < p_.iterations; ++it) {
       for (int k = 0; k < p_.stretch_passes; ++k) {
         solve_edges(lambda_e, h2);

@@ -1,5 +1,6 @@
 // Runs the built gdsr binary on bad input: every failure is one line "gdsr: error: ..." on
 // stderr and a non-zero exit status.
+#include "gdsr/data/dataset.hpp"
 #include "gdsr/geometry/mesh_ops.hpp"
 #include "gdsr/geometry/obj_io.hpp"
 #include "tests/support/cli_run.hpp"
@@ -9,6 +10,7 @@
 
 #include "gdsr/sim/cloth_solver.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -109,6 +111,13 @@ TEST_CASE("cli data: make a tiny dataset, check it and preview a frame") {
   CHECK(chk.out.find("strain: longest edge / pattern") != std::string::npos);
   CHECK(chk.out.find("stored validity figures agree with the recomputed ones") != std::string::npos);
   if (chk.out.find("agree with the") == std::string::npos) MESSAGE("stdout: " << chk.out);
+  // Each frame's figures as CSV: a header and one line per frame.
+  const std::string csv = dir / "frames.csv";
+  CHECK(gdsr_run(dir, "data check --data '" + out + "' --per-frame '" + csv + "'").status == 0);
+  const std::string rows = gdsr_test::slurp(csv);
+  CHECK(rows.rfind("frame,lr_pairs,hr_pairs,", 0) == 0);
+  CHECK(std::count(rows.begin(), rows.end(), '\n') == 1 + gdsr::load_dataset(out).manifest.frames);
+  CHECK_FALSE(fs::exists(csv + ".tmp"));
   const Run pv =
       gdsr_run(dir, "data preview --data '" + out + "' --frame 5 --size 128 --out '" + (dir / "p.png") + "'");
   CHECK(pv.status == 0);
@@ -206,7 +215,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
                                    " --iterations 3 --friction 0.1 --self-thickness 0.002 --no-self-collision"
                                    " --compression-ratio 0.5 --settle-frames 3 --contact-every 2"
                                    " --self-slack 0.002 --self-detect-every 3 --self-slack-per-pd 0.25"
-                                   " --no-limbs-pass-through");
+                                   " --no-limbs-pass-through --untangle-step 0.25");
   REQUIRE(mk.status == 0);
   const std::string manifest = gdsr_test::slurp(out + "/manifest.json");
   CHECK(manifest.find("\"iterations\": 3") != std::string::npos);
@@ -220,9 +229,10 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"self_detect_every\": 3") != std::string::npos);
   CHECK(manifest.find("\"self_slack_per_pd\": 0.25") != std::string::npos);
   CHECK(manifest.find("\"limbs_pass_through\": false") != std::string::npos);
+  CHECK(manifest.find("\"untangle_step\": 0.25") != std::string::npos);
   for (const std::string bad : {"--iterations 0", "--friction -1", "--self-thickness 1", "--bend-stiffness -2",
-                                "--compression-ratio 0", "--settle-frames -1", "--contact-every 0",
-                                "--self-slack 0", "--self-detect-every 0", "--self-slack-per-pd 0"}) {
+                                "--compression-ratio 0", "--settle-frames -1", "--contact-every 0", "--self-slack 0",
+                                "--self-detect-every 0", "--self-slack-per-pd 0", "--untangle-step -0.1"}) {
     const Run r = gdsr_run(dir, "data make --out '" + (dir / "bad") + "' " + bad);
     CHECK(r.status == 1);  // a refusal, not a crash (a sanitizer report exits 99)
     CHECK(r.err.find(bad.substr(0, bad.find(' '))) != std::string::npos);

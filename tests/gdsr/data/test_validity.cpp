@@ -11,6 +11,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -95,6 +96,19 @@ TEST_CASE("gdsr: validity figures of a stretched, lifted sheet over a rising box
   CHECK(v.hr.max_penetration == doctest::Approx(0.006).epsilon(1e-9));
   CHECK(v.hr.max_penetration_frame == 2);
   CHECK(v.hr.frames_over_limit == 1);  // 6 mm (2 mm, 1 mm and none in the others)
+  // Frame by frame: the box top per frame (LR) and 2 mm less (HR), no pairs, 2 mm apart.
+  REQUIRE(v.per_frame.size() == 4);
+  for (int t = 0; t < 4; ++t) {
+    CAPTURE(t);
+    CHECK(v.per_frame[t].lr_pairs == 0);
+    CHECK(v.per_frame[t].hr_pairs == 0);
+    CHECK(v.per_frame[t].lr_depth == doctest::Approx(top[t]).epsilon(1e-9));
+    CHECK(v.per_frame[t].hr_depth == doctest::Approx(std::max(top[t] - 0.002, 0.0)).epsilon(1e-9));
+    CHECK(v.per_frame[t].agreement == doctest::Approx(0.002).epsilon(1e-9));
+  }
+  const std::string csv = gdsr::validity_per_frame_csv(v);
+  CHECK(std::count(csv.begin(), csv.end(), '\n') == 5);
+  CHECK(csv.find("\n2,0,0,8.00,6.00,2.00\n") != std::string::npos);
 
   // Without the body: no penetration figures, and the table says so.
   opt.body = false;

@@ -110,6 +110,81 @@ TEST_CASE("self-collision: the detector flags crossing triangles as tangled") {
   CHECK(s1.num_vertex_triangle() == 0);
 }
 
+TEST_CASE("self-collision: contour minimisation pulls a bump back through the sheet it poked through") {
+  // Sheet a (border fixed) at y = 0; sheet b 1 cm under it with a bump 2.5 cm high and 5 cm
+  // across poking through a: one closed intersection contour. Only untangle() moves the
+  // vertices (no stretch, no gravity): the contour shrinks until nothing crosses (CGAL).
+  auto a = sheet(0.2, 0.02, 0.0);
+  auto b = sheet(0.2, 0.02, -0.01);
+  for (int v = 0; v < b.V.rows(); ++v) {
+    const double r = std::hypot(b.V(v, 0) - 0.004, b.V(v, 2) + 0.003);
+    if (r < 0.025) b.V(v, 1) += 0.025 * std::cos(r / 0.025 * 1.5707963);
+  }
+  const auto m = merge(a, b);
+  const int na = static_cast<int>(a.V.rows()), nv = static_cast<int>(m.V.rows());
+  std::vector<double> winv(nv, 1.0);
+  for (int v = 0; v < na; ++v)
+    if (std::max(std::abs(a.V(v, 0)), std::abs(a.V(v, 2))) > 0.1 - 1e-9) winv[v] = 0;
+  Points3 x = m.V;
+  const long pairs0 = gdsr::self_intersections(x, m.F).pairs;
+  REQUIRE(pairs0 > 0);
+  sim::SelfCollision sc(m.F, nv);
+  const double step = 0.0005;
+  int steps = 0, crossing = 1;
+  for (; steps < 400 && crossing > 0; ++steps) {
+    sc.detect(x, Points3::Zero(nv, 3), 0.0, 0.003);
+    const Points3 before = x;
+    crossing = sc.untangle(x, winv, step);
+    CHECK((x - before).rowwise().norm().maxCoeff() <= step * (1 + 1e-9));
+    for (int v = 0; v < nv; ++v)
+      if (winv[v] == 0) CHECK((x.row(v) - before.row(v)).norm() == 0);
+  }
+  CAPTURE(steps);
+  CHECK(crossing == 0);
+  CHECK(gdsr::self_intersections(x, m.F).pairs == 0);
+  // Without a tangle test there is nothing to untangle.
+  sim::SelfCollision none(m.F, nv);
+  Points3 y = m.V;
+  CHECK(none.untangle(y, winv, step) == 0);
+  CHECK((y - m.V).norm() == 0);
+}
+
+TEST_CASE("self-collision: a flap folded through a clamped sheet is pulled back out, not locked in") {
+  // A 0.2 m sheet 2 cm above a clamped 0.4 m one, its last 5 cm folded straight down through
+  // the lower sheet, without gravity (a fold is isometric: stretch has nothing to pull back,
+  // and falling, the flap came out by itself). Freed of their self-contacts, the crossing
+  // pairs stay crossed; contour minimisation pulls the flap out.
+  const double h = 0.02;
+  auto lower = sheet(0.4, h, 0.0);
+  auto upper = sheet(0.2, h, 0.02);
+  for (int v = 0; v < upper.V.rows(); ++v)
+    if (upper.V(v, 0) > 0.05) {
+      upper.V(v, 1) = 0.02 - (upper.V(v, 0) - 0.05);
+      upper.V(v, 0) = 0.05;
+    }
+  sim::Garment g;
+  g.name = "flap";
+  g.particle_distance = h;
+  g.mesh = merge(lower, upper);
+  for (int v = 0; v < lower.V.rows(); ++v)
+    if (std::max(std::abs(lower.V(v, 0)), std::abs(lower.V(v, 2))) > 0.2 - 1e-9) g.pinned.push_back(v);
+  REQUIRE(gdsr::self_intersections(g.mesh.V, g.mesh.F).pairs > 0);
+  auto pairs_after = [&](double untangle_step) {
+    sim::SimParams p;
+    p.settle_frames = 0;
+    p.untangle_step = untangle_step;
+    p.gravity = Vec3::Zero();
+    sim::ClothSolver solver(g, gdsr::Faces(), Points3(), p);
+    for (int t = 0; t < 30; ++t) solver.step(Points3(), Points3(), 1.0 / 30);
+    return gdsr::self_intersections(solver.positions(), g.mesh.F).pairs;
+  };
+  const long with = pairs_after(sim::SimParams().untangle_step), without = pairs_after(0.0);
+  CAPTURE(with);
+  CAPTURE(without);
+  CHECK(with == 0);
+  CHECK(without > 0);
+}
+
 TEST_CASE("self-collision: a fine mesh gets a slack of 0.15 particle distances, detected less often") {
   // Two resting sheets without gravity: nothing leaves its path, so detections come only on the
   // schedule, one every self_detect_every substeps of the rule in effect.
