@@ -30,9 +30,9 @@ double median(std::vector<long> v) {
 
 // Self-intersection figures of one resolution over the checked frames (frames in parallel:
 // each CGAL call is independent).
-// pairs_of(t): where frame t's pair count goes.
-template <class PairsOf> void measure_intersections(const std::vector<Points3>& frames, const Faces& F, int stride,
-                                                    ResolutionValidity& r, PairsOf pairs_of) {
+// Each checked frame's pair count also goes to rows[t].*pairs.
+void measure_intersections(const std::vector<Points3>& frames, const Faces& F, int stride, ResolutionValidity& r,
+                           std::vector<FrameValidity>& rows, long FrameValidity::*pairs_field) {
   const int T = static_cast<int>(frames.size());
   std::vector<int> checked;
   for (int t = 0; t < T; t += stride) checked.push_back(t);
@@ -52,7 +52,7 @@ template <class PairsOf> void measure_intersections(const std::vector<Points3>& 
   r.si_frames = static_cast<int>(checked.size());
   for (size_t k = 0; k < checked.size(); ++k) {
     pairs.push_back(si[k].pairs);
-    pairs_of(checked[k]) = si[k].pairs;
+    rows[checked[k]].*pairs_field = si[k].pairs;
     r.si_clean_frames += si[k].pairs == 0;
     if (si[k].pairs > r.si_max_pairs || r.si_max_frame < 0) {
       r.si_max_pairs = si[k].pairs;
@@ -212,11 +212,9 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
     }
     if (progress) progress(t + 1, steps);
   }
-  measure_intersections(d.lr_frames, d.lr.F, opt.intersection_stride, v.lr,
-                        [&](int t) -> long& { return v.per_frame[t].lr_pairs; });
+  measure_intersections(d.lr_frames, d.lr.F, opt.intersection_stride, v.lr, v.per_frame, &FrameValidity::lr_pairs);
   if (progress) progress(T + 1, steps);
-  measure_intersections(d.hr_frames, d.hr.F, opt.intersection_stride, v.hr,
-                        [&](int t) -> long& { return v.per_frame[t].hr_pairs; });
+  measure_intersections(d.hr_frames, d.hr.F, opt.intersection_stride, v.hr, v.per_frame, &FrameValidity::hr_pairs);
   if (progress) progress(steps, steps);
   return v;
 }
@@ -285,8 +283,10 @@ ResolutionValidity resolution_from_json(const nlohmann::json& j, bool body, cons
   r.strain.E_uv = take<double>(st, "E_uv", where + "strain.");
   // Manifests written before E_u was split: not measured.
   const bool split = st.contains("E_u_stretched");
-  r.strain.E_u_stretched = split ? take<double>(st, "E_u_stretched", where + "strain.") : std::numeric_limits<double>::quiet_NaN();
-  r.strain.E_v_stretched = split ? take<double>(st, "E_v_stretched", where + "strain.") : std::numeric_limits<double>::quiet_NaN();
+  r.strain.E_u_stretched =
+      split ? take<double>(st, "E_u_stretched", where + "strain.") : std::numeric_limits<double>::quiet_NaN();
+  r.strain.E_v_stretched =
+      split ? take<double>(st, "E_v_stretched", where + "strain.") : std::numeric_limits<double>::quiet_NaN();
   // Manifests written before torn cloth was counted: not measured.
   if (st.contains("torn_frames")) {
     r.max_edge_stretch = take<double>(st, "max_edge_stretch", where + "strain.");
