@@ -5,7 +5,7 @@
 #   bench/sim_sweep.sh BUILD_DIR OUT_DIR OPTION "VALUES" [GARMENT] [MOTION] [START_S] [SECONDS] ["FLAGS"]
 # Defaults: pants on ../shared/motions/cmu-walk/131_01.bvh from 2 s for 4 s, no flags.
 # One after another, one thread each (OMP_NUM_THREADS=1): ~8 min per 10 mm pants run here.
-# Two sweeps it was written for:
+# Sweeps it was written for:
 # - untangling, where a lunge pinches the 10 mm trouser leg behind the knee at frame 44 of
 #   131_01 (0: off, revision 11; 0.3 crumples the cloth: 16,407 pairs):
 #     bench/sim_sweep.sh build OUT --untangle-step "0 0.05 0.1"
@@ -13,6 +13,9 @@
 #   whose figures stay inside this spread is not measured by one run of each: the 10 mm pants
 #   on 131_02 gave 44.1%, 100% and 97.1% of HR frames free of self-intersections (revision 12):
 #     bench/sim_sweep.sh build OUT --friction "0.3 0.30001 0.30002" pants ../shared/motions/cmu-walk/131_02.bvh
+# - tracking: how closely the HR simulation follows the LR one (0: independent), agreement
+#   against the wrinkles HR adds (curvature over the upsampled LR's), and the cost:
+#     bench/sim_sweep.sh build OUT --track-rate "0 2 5 10" skirt_short /usr/share/assimp/models/BVH/01_01.bvh 1 2
 set -e
 usage="usage: $0 BUILD_DIR OUT_DIR OPTION VALUES [GARMENT] [MOTION] [START_S] [SECONDS] [FLAGS]"
 build=$(cd "${1:?$usage}" && pwd)

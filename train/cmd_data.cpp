@@ -64,6 +64,7 @@ struct MakeArgs {
   int iterations = -1, stretch_passes = -1, settle_frames = -1, contact_every = -1, self_detect_every = -1;
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN, self_slack = NAN;
   double self_slack_per_pd = NAN, untangle_step = NAN;
+  double track_rate = 0;  // 1/s: the HR simulation follows the LR one at the LR scale (sim/cloth_tracking.hpp)
   bool self_collision = true;
   bool limbs_pass_through = true;
   bool independent_hr = false;  // settle HR from its own placement, not from the settled LR garment
@@ -96,13 +97,14 @@ struct SimRun {
 };
 
 SimRun simulate_one(sim::Garment garment, const char* label, const gdsr::BodySequence& body,
-                    const sim::SimParams& params, const gdsr::Points3* start = nullptr) {
+                    const sim::SimParams& params, const gdsr::Points3* start = nullptr,
+                    const sim::Guide* guide = nullptr) {
   SimRun r;
   r.garment = std::move(garment);
   gdsr::ProgressBar bar(std::string("simulate ") + label + " (" + std::to_string(r.garment.mesh.V.rows()) +
                         " vertices)");
   const double t0 = now_seconds(), c0 = cpu_seconds();
-  r.frames = sim::simulate(r.garment, body, params, bar.callback(), start);
+  r.frames = sim::simulate(r.garment, body, params, bar.callback(), start, guide);
   bar.finish();
   const double steps = static_cast<double>(std::max<size_t>(1, r.frames.size() + params.settle_frames));
   r.seconds_per_frame = (now_seconds() - t0) / steps;
@@ -187,6 +189,7 @@ void run_make(const MakeArgs& a) {
   if (a.self_detect_every > 0) params.self_detect_every = a.self_detect_every;
   if (!std::isnan(a.compression_ratio)) params.compression_ratio = a.compression_ratio;
   if (!std::isnan(a.untangle_step)) params.untangle_step = a.untangle_step;
+  params.track_rate = a.track_rate;
   params.self_collision = a.self_collision;
   params.limbs_pass_through = a.limbs_pass_through;
   sim::Garment lr_garment = sim::make_garment(a.garment, a.lr_pd, body.rest_mesh());
@@ -202,7 +205,10 @@ void run_make(const MakeArgs& a) {
   const SimRun lr = simulate_one(std::move(lr_garment), "LR", body, params);
   // Both resolutions start the clip in one drape (see sim::simulate_frames).
   const gdsr::Points3 hr_start = a.independent_hr ? gdsr::Points3() : gdsr::upsample(d.corr, lr.frames.front());
-  const SimRun hr = simulate_one(std::move(hr_garment), "HR", body, params, a.independent_hr ? nullptr : &hr_start);
+  const sim::GuideTracker tracker(d.corr);
+  const sim::Guide guide{tracker, lr.frames};
+  const SimRun hr = simulate_one(std::move(hr_garment), "HR", body, params, a.independent_hr ? nullptr : &hr_start,
+                                 a.track_rate > 0 ? &guide : nullptr);
   d.lr_frames = lr.frames;
   d.hr_frames = hr.frames;
   d.body_frames = body.frames;
@@ -240,6 +246,7 @@ void run_make(const MakeArgs& a) {
                   {"self_slack_per_pd", params.self_slack_per_pd},
                   {"self_detect_every", params.self_detect_every},
                   {"untangle_step", params.untangle_step},
+                  {"hr_track_rate_1_s", params.track_rate},
                   {"compression_ratio", params.compression_ratio},
                   {"compression_pd_ref_m", params.compression_pd_ref},
                   {"clip_start_s", a.start},
@@ -307,6 +314,10 @@ bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why
       why = "built with another HR start";
       return false;
     }
+    if (!same(sp.value("hr_track_rate_1_s", 0.0), a.track_rate)) {
+      why = "built with another HR tracking rate";
+      return false;
+    }
     gdsr::load_dataset(dir);
   } catch (const std::exception& e) {
     why = std::string("invalid (") + e.what() + ")";
@@ -341,6 +352,7 @@ void run_recipe(const MakeArgs& a) {
     one.hr_pd = r.hr_pd;
     one.fps = r.fps;
     one.rest_blend_frames = r.rest_blend;
+    one.track_rate = r.hr_track_rate;
     one.out = (fs::path(a.out) / c.name).string();
     std::string why;
     if (built_and_valid(one.out, one, why)) {
@@ -629,6 +641,10 @@ void add_data_command(CLI::App& app) {
                    "per substep, the most cloth that went through itself is moved to undo it, in self-thicknesses "
                    "(default: the solver's; 0: off, as before solver revision 12)")
       ->check(finite_range(0.0, 1.0));
+  make->add_option("--track-rate", mk->track_rate,
+                   "1/s: the HR simulation follows the LR one at the LR scale, a difference in drape decaying at this "
+                   "rate, and adds the finer wrinkles (default 0: independent, as before)")
+      ->check(finite_range(0.0, 1000.0));
   make->add_option("--contact-every", mk->contact_every,
                    "substeps between body contact refreshes (default: the solver's)")
       ->check(CLI::Range(1, 1000));

@@ -79,7 +79,8 @@ Recipe load_recipe(const std::string& path, const std::vector<std::string>& garm
     fail(path, "invalid JSON");
   }
   if (!j.is_object()) fail(path, "a recipe is a JSON object");
-  static const std::set<std::string> known = {"comment", "lr_pd", "hr_pd", "fps", "rest_blend", "partner_subjects", "clips"};
+  static const std::set<std::string> known = {"comment", "lr_pd", "hr_pd", "fps", "rest_blend", "hr_track_rate",
+                                              "partner_subjects", "clips"};
   for (const auto& [key, v] : j.items())
     if (!known.count(key)) fail(path, "unknown key \"" + key + "\"");
 
@@ -92,6 +93,7 @@ Recipe load_recipe(const std::string& path, const std::vector<std::string>& garm
   const double blend = number(j, "rest_blend", path, 0, 1000, r.rest_blend, false);
   if (std::floor(blend) != blend) fail(path, "\"rest_blend\" must be a whole number of frames");
   r.rest_blend = static_cast<int>(blend);
+  r.hr_track_rate = number(j, "hr_track_rate", path, 0, 1000, r.hr_track_rate, false);
 
   std::vector<std::vector<std::string>> groups;
   if (j.contains("partner_subjects")) {

@@ -4,6 +4,7 @@
 //
 //   {
 //     "lr_pd": 0.03, "hr_pd": 0.01, "fps": 30, "rest_blend": 15,      (optional, these defaults)
+//     "hr_track_rate": 0,   (optional, 1/s: HR follows LR, `data make --track-rate`)
 //     "partner_subjects": [["60", "61"]],                             (optional)
 //     "clips": [
 //       {"garment": "skirt_short", "motion": "../../shared/motions/cmu-salsa/60_02.bvh",
@@ -34,6 +35,7 @@ struct Recipe {
   std::string path;  // the file it was read from
   double lr_pd = 0.03, hr_pd = 0.01, fps = 30;
   int rest_blend = 15;
+  double hr_track_rate = 0;  // 1/s (sim::SimParams::track_rate)
   std::vector<RecipeClip> clips;
 };
 

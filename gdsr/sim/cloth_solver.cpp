@@ -531,6 +531,22 @@ void ClothSolver::track_self_slack() {
     if ((x_.row(v) - x_detect_.row(v) - a * motion_.row(v)).squaredNorm() > s2) since_detect_ = detect_interval_;
 }
 
+void ClothSolver::set_guide(const GuideTracker* tracker, const Points3* from, const Points3* to) {
+  if (tracker && (!from || !to || tracker->hr_vertices() != x_.rows() || from->rows() != tracker->lr_vertices() ||
+                  to->rows() != tracker->lr_vertices()))
+    gdsr::fail("sim/cloth_solver", "the guide's vertex counts do not match the garment and its LR mesh");
+  tracker_ = tracker;
+  guide_from_ = tracker ? from : nullptr;
+  guide_to_ = tracker ? to : nullptr;
+}
+
+void ClothSolver::track_guide(double a0, double dt, double h) {
+  if (!tracker_ || !(p_.track_rate > 0)) return;
+  const Points3 g = (1 - a0) * *guide_from_ + a0 * *guide_to_;
+  const Points3 gv = (*guide_to_ - *guide_from_) / dt;
+  tracker_->pull(g, gv, 1 - std::exp(-p_.track_rate * h), winv_, x_, v_);
+}
+
 void ClothSolver::step(const Points3& body_from, const Points3& body_to, double dt) {
   if (!(dt > 0)) gdsr::fail("sim/cloth_solver", "frame time must be positive");
   const bool has_body = bodyF_.rows() > 0;
@@ -555,6 +571,7 @@ void ClothSolver::step(const Points3& body_from, const Points3& body_to, double 
     } else if (s % p_.contact_every == 0) {
       refresh_contacts(body_now);
     }
+    track_guide(static_cast<double>(s) / n, dt, h);
     detect_self_contacts(h);
     predict(h, decay);
     if (has_body) place_pins(body_now);
@@ -581,8 +598,11 @@ void ClothSolver::step(const Points3& body_from, const Points3& body_to, double 
 
 std::vector<Points3> simulate_frames(const Garment& g, const gdsr::Faces& body_F, const std::vector<Points3>& frames,
                                      double fps, const SimParams& p, const gdsr::ProgressFn& progress,
-                                     const Points3* start) {
+                                     const Points3* start, const Guide* guide) {
   if (frames.empty()) gdsr::fail("sim/cloth_solver", "no body frames");
+  if (guide && guide->frames.size() != frames.size())
+    gdsr::fail("sim/cloth_solver", "the guide has " + std::to_string(guide->frames.size()) + " frames for " +
+                                       std::to_string(frames.size()) + " body frames");
   if (!(fps > 0)) gdsr::fail("sim/cloth_solver", "fps must be positive");
   for (size_t t = 0; t < frames.size(); ++t)
     if (frames[t].rows() != frames[0].rows() || !frames[t].allFinite())
@@ -600,6 +620,7 @@ std::vector<Points3> simulate_frames(const Garment& g, const gdsr::Faces& body_F
   const double blend_frames = std::max(1.0, p.settle_rest_blend * p.settle_frames);
   for (int k = 0; k < p.settle_frames; ++k) {
     solver.set_rest_blend(start ? 1.0 : std::min(1.0, (k + 1) / blend_frames));
+    if (guide) solver.set_guide(&guide->tracker, &guide->frames[0], &guide->frames[0]);
     solver.step(frames[0], frames[0], dt);
     if (progress) progress(++done, total);
   }
@@ -612,6 +633,7 @@ std::vector<Points3> simulate_frames(const Garment& g, const gdsr::Faces& body_F
   if (progress) progress(++done, total);
   for (size_t t = 1; t < frames.size(); ++t) {
     try {
+      if (guide) solver.set_guide(&guide->tracker, &guide->frames[t - 1], &guide->frames[t]);
       solver.step(frames[t - 1], frames[t], dt);
     } catch (const std::runtime_error& e) {
       gdsr::fail("sim/cloth_solver", "frame " + std::to_string(t) + ": " + e.what());

@@ -24,6 +24,7 @@
 #include "gdsr/sim/cloth_pins.hpp"
 #include "gdsr/sim/cloth_self_collision.hpp"
 #include "gdsr/sim/cloth_tethers.hpp"
+#include "gdsr/sim/cloth_tracking.hpp"
 #include "gdsr/sim/garments.hpp"
 
 #include <array>
@@ -150,6 +151,16 @@ struct SimParams {
   int stretch_passes = 4;         // stretch (+ tether) passes per iteration: cheap (~1% of a substep each)
   bool tethers = true;            // long-range attachments to the pins (sim/cloth_tethers.hpp)
   double tether_stretch = 0.002;  // stretch a tether allows beyond the rest distance along the cloth (0.2%)
+  double track_rate = 0;          // 1/s: with a guide (an LR simulation of the same garment), how fast a difference
+                                  // in drape at the LR scale decays (sim/cloth_tracking.hpp); 0: independent
+};
+
+// An LR simulation for an HR one to follow (SimParams::track_rate): the tracker holds the
+// LR-HR correspondence, frames[t] the LR positions (LR welded vertices x 3, metres) at body
+// frame t. The settle follows frames[0].
+struct Guide {
+  const GuideTracker& tracker;
+  const std::vector<gdsr::Points3>& frames;
 };
 
 // Stateful solver for one garment on one body topology.
@@ -171,6 +182,9 @@ class ClothSolver {
   // hip, a t-shirt's shoulder fold: edges 0.1x to 3x their pattern length) would otherwise snap
   // back at the speed limit in the first substeps; the settle eases it in instead.
   void set_rest_blend(double a);
+  // The guide's positions at the start and the end of the next step (LR welded vertices x 3,
+  // metres; both must outlive the step); nullptr: no tracking. See SimParams::track_rate.
+  void set_guide(const GuideTracker* tracker, const gdsr::Points3* from, const gdsr::Points3* to);
   const gdsr::Points3& positions() const { return x_; }
   const gdsr::Points3& velocities() const { return v_; }       // m/s
   const std::vector<double>& masses() const { return mass_; }  // kg per vertex (pinned too)
@@ -224,6 +238,7 @@ class ClothSolver {
   void solve_self_contacts();
   void update_velocities(double h);
   void track_self_slack();
+  void track_guide(double a0, double dt, double h);  // a0: the substep's start as a fraction of the frame
 
   SimParams p_;
   gdsr::Faces F_, bodyF_;
@@ -252,6 +267,8 @@ class ClothSolver {
   int since_detect_ = 1 << 30;  // substeps since the last detection
   int detect_interval_ = 1;     // substeps the last detection covers (self_detect_every or fewer for fast cloth)
   bool tangle_test_due_ = true;  // the next detection also runs the tangle test (once per frame)
+  const GuideTracker* tracker_ = nullptr;
+  const gdsr::Points3 *guide_from_ = nullptr, *guide_to_ = nullptr;
 };
 
 // Simulates the garment on body frames (each frames[t] is a pose of body_F, metres) at
@@ -264,10 +281,11 @@ class ClothSolver {
 // CMU 01_01, 30 against 10 mm: settled separately they differed by 21 mm at frame 0, almost
 // all of it folds at different angles around the body (0.3 mm at rest); from the shared start
 // by 12 mm, and by 31.6 instead of 34.5 mm over 4 s of the clip.
+// With `guide` and p.track_rate > 0, the garment follows the guide's frames (one per body frame).
 std::vector<gdsr::Points3> simulate_frames(const Garment& g, const gdsr::Faces& body_F,
                                            const std::vector<gdsr::Points3>& frames, double fps, const SimParams& p,
                                            const gdsr::ProgressFn& progress = {},
-                                           const gdsr::Points3* start = nullptr);
+                                           const gdsr::Points3* start = nullptr, const Guide* guide = nullptr);
 
 }  // namespace sim
 
@@ -275,7 +293,7 @@ namespace sim {
 // Simulates the garment on a body sequence (see simulate_frames).
 inline std::vector<gdsr::Points3> simulate(const Garment& g, const gdsr::BodySequence& body, const SimParams& p,
                                            const gdsr::ProgressFn& progress = {},
-                                           const gdsr::Points3* start = nullptr) {
-  return simulate_frames(g, body.F, body.frames, body.fps, p, progress, start);
+                                           const gdsr::Points3* start = nullptr, const Guide* guide = nullptr) {
+  return simulate_frames(g, body.F, body.frames, body.fps, p, progress, start, guide);
 }
 }  // namespace sim

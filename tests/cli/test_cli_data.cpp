@@ -215,7 +215,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
                                    " --iterations 3 --friction 0.1 --self-thickness 0.002 --no-self-collision"
                                    " --compression-ratio 0.5 --settle-frames 3 --contact-every 2"
                                    " --self-slack 0.002 --self-detect-every 3 --self-slack-per-pd 0.25"
-                                   " --no-limbs-pass-through --untangle-step 0.25");
+                                   " --no-limbs-pass-through --untangle-step 0.25 --track-rate 4");
   REQUIRE(mk.status == 0);
   const std::string manifest = gdsr_test::slurp(out + "/manifest.json");
   CHECK(manifest.find("\"iterations\": 3") != std::string::npos);
@@ -230,9 +230,11 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"self_slack_per_pd\": 0.25") != std::string::npos);
   CHECK(manifest.find("\"limbs_pass_through\": false") != std::string::npos);
   CHECK(manifest.find("\"untangle_step\": 0.25") != std::string::npos);
+  CHECK(manifest.find("\"hr_track_rate_1_s\": 4") != std::string::npos);
   for (const std::string bad : {"--iterations 0", "--friction -1", "--self-thickness 1", "--bend-stiffness -2",
                                 "--compression-ratio 0", "--settle-frames -1", "--contact-every 0", "--self-slack 0",
-                                "--self-detect-every 0", "--self-slack-per-pd 0", "--untangle-step -0.1"}) {
+                                "--self-detect-every 0", "--self-slack-per-pd 0", "--untangle-step -0.1",
+                                "--track-rate -1", "--track-rate nan"}) {
     const Run r = gdsr_run(dir, "data make --out '" + (dir / "bad") + "' " + bad);
     CHECK(r.status == 1);  // a refusal, not a crash (a sanitizer report exits 99)
     CHECK(r.err.find(bad.substr(0, bad.find(' '))) != std::string::npos);
@@ -272,6 +274,16 @@ TEST_CASE("cli data: a recipe builds every clip once, skips what is built and va
   CHECK(repair.out.find("unseen (invalid") != std::string::npos);
   CHECK(repair.out.find("1 built, 1 already built") != std::string::npos);
   CHECK(gdsr_run(dir, "data check --data '" + out + "/unseen'").status == 0);
+
+  // Another HR tracking rate is another dataset: both are rebuilt, with the rate in the manifest.
+  std::string tracked = gdsr_test::slurp(dir / "r.json");
+  tracked.insert(1, R"("hr_track_rate": 3, )");
+  std::ofstream(dir / "r.json") << tracked;
+  const Run retrack = gdsr_run(dir, make);
+  REQUIRE(retrack.status == 0);
+  CHECK(retrack.out.find("built with another HR tracking rate") != std::string::npos);
+  CHECK(retrack.out.find("2 built, 0 already built") != std::string::npos);
+  CHECK(gdsr_test::slurp(out + "/unseen/manifest.json").find("\"hr_track_rate_1_s\": 3") != std::string::npos);
 
   check_one_line_error(gdsr_run(dir, make + " --garment pants"), "--recipe");
   check_one_line_error(gdsr_run(dir, "data make --recipe '" + (dir / "none.json") + "' --out '" + out + "'"),

@@ -55,6 +55,7 @@ TEST_CASE("recipe: clips, defaults, names and motion paths relative to the recip
   CHECK(r.hr_pd == 0.015);
   CHECK(r.fps == 30);
   CHECK(r.rest_blend == 15);
+  CHECK(r.hr_track_rate == 0);
   REQUIRE(r.clips.size() == 3);
   CHECK(r.clips[0].name == "skirt_short_60_03_2s");
   CHECK(r.clips[0].motion == (d.dir / "motions" / "60_03.bvh").string());
@@ -78,6 +79,7 @@ TEST_CASE("recipe: bad recipes are refused with the file and the key named") {
       {R"({"clip": [1]})", "unknown key \"clip\""},
       {R"({"lr_pd": 0.01, "hr_pd": 0.02, "clips": [)" + clip("60_03.bvh", "train") + "]}", "coarser"},
       {R"({"fps": 0, "clips": [)" + clip("60_03.bvh", "train") + "]}", "\"fps\""},
+      {R"({"hr_track_rate": -1, "clips": [)" + clip("60_03.bvh", "train") + "]}", "\"hr_track_rate\""},
       {R"({"clips": [{"garment": "cape", "motion": "motions/60_03.bvh", "seconds": 1}]})", "unknown garment"},
       {R"({"clips": [{"garment": "pants", "motion": "motions/none.bvh", "seconds": 1}]})", "none.bvh"},
       {R"({"clips": [{"garment": "pants", "motion": "motions/60_03.bvh"}]})", "clips[0]: missing \"seconds\""},
@@ -99,6 +101,8 @@ TEST_CASE("recipe: bad recipes are refused with the file and the key named") {
   }
   CHECK(error_of(d, "{" + partners + R"("clips": [)" + clip("60_03.bvh", "heldout") + ", " +
                         clip("61_03.bvh", "heldout") + "]}") == "");
+  CHECK(gdsr::load_recipe(d.write(R"({"hr_track_rate": 5, "clips": [)" + clip("60_03.bvh", "train") + "]}"), kGarments)
+            .hr_track_rate == 5);
   try {
     gdsr::load_recipe((d.dir / "missing.json").string(), kGarments);
     FAIL("no error");
