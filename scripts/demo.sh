@@ -2,7 +2,8 @@
 # The main job on the built-in default data, start to end (about 6 minutes on 2 cores):
 #   1-2. `gdsr demo`: our autograd trains a small MLP; gradient-check summary of every op;
 #   3.   paired LR (30 mm) / HR (10 mm) skirt simulations with our cloth solver on CMU
-#        motion capture: clip 01_01 for training, 01_03 (unseen motion) for testing;
+#        motion capture (HR follows LR at the LR scale and adds finer folds: --track-rate):
+#        clip 01_01 for training, 01_03 (unseen motion) for testing;
 #   4.   `gdsr train`: a small GDSR model on the training sequence;
 #   5.   `gdsr infer` + `gdsr eval`: roll-out on the unseen motion, compared with the HR
 #        simulation (vertex error, normal-map SSIM, stretch energies) and a preview PNG;

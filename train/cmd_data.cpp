@@ -64,7 +64,7 @@ struct MakeArgs {
   int iterations = -1, stretch_passes = -1, settle_frames = -1, contact_every = -1, self_detect_every = -1;
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN, self_slack = NAN;
   double self_slack_per_pd = NAN, untangle_step = NAN;
-  double track_rate = 0;  // 1/s: the HR simulation follows the LR one at the LR scale (sim/cloth_tracking.hpp)
+  double track_rate = NAN;  // 1/s: the HR simulation follows the LR one at the LR scale (sim/cloth_tracking.hpp)
   bool self_collision = true;
   bool limbs_pass_through = true;
   bool independent_hr = false;  // settle HR from its own placement, not from the settled LR garment
@@ -88,6 +88,11 @@ double cpu_seconds() {
 
 // Where the HR settle started, as the manifest's sim_params.hr_start records it.
 const char* hr_start_name(const MakeArgs& a) { return a.independent_hr ? "placement" : "settled_lr"; }
+
+// The HR tracking rate in effect, 1/s (--track-rate, else the solver's default).
+double effective_track_rate(const MakeArgs& a) {
+  return std::isnan(a.track_rate) ? sim::SimParams().track_rate : a.track_rate;
+}
 
 struct SimRun {
   sim::Garment garment;
@@ -189,7 +194,7 @@ void run_make(const MakeArgs& a) {
   if (a.self_detect_every > 0) params.self_detect_every = a.self_detect_every;
   if (!std::isnan(a.compression_ratio)) params.compression_ratio = a.compression_ratio;
   if (!std::isnan(a.untangle_step)) params.untangle_step = a.untangle_step;
-  params.track_rate = a.track_rate;
+  params.track_rate = effective_track_rate(a);
   params.self_collision = a.self_collision;
   params.limbs_pass_through = a.limbs_pass_through;
   sim::Garment lr_garment = sim::make_garment(a.garment, a.lr_pd, body.rest_mesh());
@@ -208,7 +213,7 @@ void run_make(const MakeArgs& a) {
   const sim::GuideTracker tracker(d.corr);
   const sim::Guide guide{tracker, lr.frames};
   const SimRun hr = simulate_one(std::move(hr_garment), "HR", body, params, a.independent_hr ? nullptr : &hr_start,
-                                 a.track_rate > 0 ? &guide : nullptr);
+                                 params.track_rate > 0 ? &guide : nullptr);
   d.lr_frames = lr.frames;
   d.hr_frames = hr.frames;
   d.body_frames = body.frames;
@@ -314,7 +319,7 @@ bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why
       why = "built with another HR start";
       return false;
     }
-    if (!same(sp.value("hr_track_rate_1_s", 0.0), a.track_rate)) {
+    if (!same(sp.value("hr_track_rate_1_s", 0.0), effective_track_rate(a))) {
       why = "built with another HR tracking rate";
       return false;
     }
@@ -352,7 +357,7 @@ void run_recipe(const MakeArgs& a) {
     one.hr_pd = r.hr_pd;
     one.fps = r.fps;
     one.rest_blend_frames = r.rest_blend;
-    one.track_rate = r.hr_track_rate;
+    if (!std::isnan(r.hr_track_rate)) one.track_rate = r.hr_track_rate;  // else --track-rate or the solver's
     one.out = (fs::path(a.out) / c.name).string();
     std::string why;
     if (built_and_valid(one.out, one, why)) {
@@ -642,8 +647,8 @@ void add_data_command(CLI::App& app) {
                    "(default: the solver's; 0: off, as before solver revision 12)")
       ->check(finite_range(0.0, 1.0));
   make->add_option("--track-rate", mk->track_rate,
-                   "1/s: the HR simulation follows the LR one at the LR scale, a difference in drape decaying at this "
-                   "rate, and adds the finer wrinkles (default 0: independent, as before)")
+                   "1/s: HR follows the LR simulation at the LR scale, a difference in drape decaying at this rate, "
+                   "and adds finer wrinkles (default: the solver's, 10; 0: independent, as before revision 13)")
       ->check(finite_range(0.0, 1000.0));
   make->add_option("--contact-every", mk->contact_every,
                    "substeps between body contact refreshes (default: the solver's)")

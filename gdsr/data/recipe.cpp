@@ -79,8 +79,8 @@ Recipe load_recipe(const std::string& path, const std::vector<std::string>& garm
     fail(path, "invalid JSON");
   }
   if (!j.is_object()) fail(path, "a recipe is a JSON object");
-  static const std::set<std::string> known = {"comment", "lr_pd", "hr_pd", "fps", "rest_blend", "hr_track_rate",
-                                              "partner_subjects", "clips"};
+  static const std::set<std::string> known = {
+      "comment", "lr_pd", "hr_pd", "fps", "rest_blend", "hr_track_rate", "partner_subjects", "clips"};
   for (const auto& [key, v] : j.items())
     if (!known.count(key)) fail(path, "unknown key \"" + key + "\"");
 

@@ -4,7 +4,7 @@
 //
 //   {
 //     "lr_pd": 0.03, "hr_pd": 0.01, "fps": 30, "rest_blend": 15,      (optional, these defaults)
-//     "hr_track_rate": 0,   (optional, 1/s: HR follows LR, `data make --track-rate`)
+//     "hr_track_rate": 10,  (optional, 1/s: HR follows LR, `data make --track-rate`; absent: the solver's)
 //     "partner_subjects": [["60", "61"]],                             (optional)
 //     "clips": [
 //       {"garment": "skirt_short", "motion": "../../shared/motions/cmu-salsa/60_02.bvh",
@@ -18,6 +18,7 @@
 // a held-out clip whose partner was trained on is not unseen. Units: metres, seconds.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -35,7 +36,7 @@ struct Recipe {
   std::string path;  // the file it was read from
   double lr_pd = 0.03, hr_pd = 0.01, fps = 30;
   int rest_blend = 15;
-  double hr_track_rate = 0;  // 1/s (sim::SimParams::track_rate)
+  double hr_track_rate = NAN;  // 1/s (sim::SimParams::track_rate); NaN: absent, the solver's default
   std::vector<RecipeClip> clips;
 };
 

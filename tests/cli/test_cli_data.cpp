@@ -231,10 +231,10 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"limbs_pass_through\": false") != std::string::npos);
   CHECK(manifest.find("\"untangle_step\": 0.25") != std::string::npos);
   CHECK(manifest.find("\"hr_track_rate_1_s\": 4") != std::string::npos);
-  for (const std::string bad : {"--iterations 0", "--friction -1", "--self-thickness 1", "--bend-stiffness -2",
-                                "--compression-ratio 0", "--settle-frames -1", "--contact-every 0", "--self-slack 0",
-                                "--self-detect-every 0", "--self-slack-per-pd 0", "--untangle-step -0.1",
-                                "--track-rate -1", "--track-rate nan"}) {
+  for (const std::string bad :
+       {"--iterations 0", "--friction -1", "--self-thickness 1", "--bend-stiffness -2", "--compression-ratio 0",
+        "--settle-frames -1", "--contact-every 0", "--self-slack 0", "--self-detect-every 0", "--self-slack-per-pd 0",
+        "--untangle-step -0.1", "--track-rate -1", "--track-rate nan"}) {
     const Run r = gdsr_run(dir, "data make --out '" + (dir / "bad") + "' " + bad);
     CHECK(r.status == 1);  // a refusal, not a crash (a sanitizer report exits 99)
     CHECK(r.err.find(bad.substr(0, bad.find(' '))) != std::string::npos);
