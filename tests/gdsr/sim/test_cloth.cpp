@@ -2,6 +2,7 @@
 
 #include "gdsr/error.hpp"
 #include "tests/support/cloth_bodies.hpp"
+#include "tests/support/square_cloth.hpp"
 #include "gdsr/sim/cloth_solver.hpp"
 #include "gdsr/sim/garments.hpp"
 #include "gdsr/sim/pattern.hpp"
@@ -20,20 +21,7 @@ using gdsr::Vec3;
 
 namespace {
 
-// Flat square cloth (side metres) at height y, centred over x = z = 0, from a one-panel
-// pattern meshed at particle distance h; the pattern's (u, v) maps to (x, -z) so the
-// counter-clockwise UV faces have upward normals.
-sim::Garment square_cloth(double side, double h, double y) {
-  sim::Pattern p;
-  p.panels.push_back({"square", {Vec2(0, 0), Vec2(side, 0), Vec2(side, side), Vec2(0, side)}});
-  auto pm = sim::mesh_pattern(p, h);
-  sim::place_pattern(pm, [&](int, const Vec2& uv) { return Vec3(uv.x() - side / 2, y, side / 2 - uv.y()); });
-  sim::Garment g;
-  g.mesh = pm.mesh;
-  g.name = "square";
-  g.particle_distance = h;
-  return g;
-}
+using gdsr_test::square_cloth;
 
 double signed_volume(const gdsr::TriMesh& m) {
   double v = 0;

@@ -5,31 +5,18 @@
 #include "gdsr/geometry/wrinkles.hpp"
 #include "gdsr/sim/cloth_solver.hpp"
 #include "gdsr/sim/cloth_tracking.hpp"
-#include "gdsr/sim/pattern.hpp"
 #include "tests/support/cloth_bodies.hpp"
+#include "tests/support/square_cloth.hpp"
 
 #include <cmath>
 #include <limits>
 
 using gdsr::Points3;
-using gdsr::Vec2;
 using gdsr::Vec3;
 
 namespace {
 
-// Flat square cloth (side metres) at height y from a one-panel pattern at particle distance h;
-// both resolutions come from the same pattern, so their UV layouts overlap.
-sim::Garment square(double side, double h, double y) {
-  sim::Pattern p;
-  p.panels.push_back({"square", {Vec2(0, 0), Vec2(side, 0), Vec2(side, side), Vec2(0, side)}});
-  auto pm = sim::mesh_pattern(p, h);
-  sim::place_pattern(pm, [&](int, const Vec2& uv) { return Vec3(uv.x() - side / 2, y, side / 2 - uv.y()); });
-  sim::Garment g;
-  g.mesh = pm.mesh;
-  g.name = "square";
-  g.particle_distance = h;
-  return g;
-}
+using gdsr_test::square_cloth;
 
 // Mean distance from each point of X to the closest point of the surface (V, F), brute force
 // over triangles: a yardstick that does not use the correspondence the tracker pulls along.
@@ -54,7 +41,7 @@ double max_row_norm(const Points3& X, const Points3& Y) { return (X - Y).rowwise
 }  // namespace
 
 TEST_CASE("cloth tracking: the pull moves what the LR mesh can hold by beta and leaves fine wrinkles alone") {
-  const sim::Garment lr = square(0.6, 0.03, 0), hr = square(0.6, 0.01, 0);
+  const sim::Garment lr = square_cloth(0.6, 0.03, 0), hr = square_cloth(0.6, 0.01, 0);
   const gdsr::Correspondence c = gdsr::compute_correspondence(lr.mesh, hr.mesh);
   const sim::GuideTracker tracker(c);
   const Points3 g = lr.mesh.V, target = gdsr::upsample(c, g);
@@ -104,7 +91,7 @@ TEST_CASE("cloth tracking: a tracked HR drape follows the LR one and keeps finer
   // 6.1 mm independent, 4.1 mm tracked; curvature 1.33x and 1.20x the upsampled LR's).
   const double r = 0.2;
   const auto sphere = sim::make_sphere(Vec3(0, 0, 0), r, 32, 64);
-  const sim::Garment lr = square(0.7, 0.03, r + 0.03), hr = square(0.7, 0.01, r + 0.03);
+  const sim::Garment lr = square_cloth(0.7, 0.03, r + 0.03), hr = square_cloth(0.7, 0.01, r + 0.03);
   sim::SimParams p;
   p.settle_frames = 0;
   p.damping = 2.0;

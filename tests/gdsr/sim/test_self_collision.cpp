@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include "tests/support/cloth_bodies.hpp"
+#include "tests/support/square_cloth.hpp"
 #include "gdsr/sim/cloth_self_collision.hpp"
 #include "gdsr/sim/cloth_solver.hpp"
 #include "gdsr/sim/garments.hpp"
@@ -24,13 +25,7 @@ using gdsr::Vec3;
 namespace {
 
 // Horizontal square sheet (side m) at height y centred over x = z = 0 at particle distance h.
-gdsr::GarmentMesh sheet(double side, double h, double y) {
-  sim::Pattern p;
-  p.panels.push_back({"square", {Vec2(0, 0), Vec2(side, 0), Vec2(side, side), Vec2(0, side)}});
-  auto pm = sim::mesh_pattern(p, h);
-  sim::place_pattern(pm, [&](int, const Vec2& uv) { return Vec3(uv.x() - side / 2, y, side / 2 - uv.y()); });
-  return pm.mesh;
-}
+gdsr::GarmentMesh sheet(double side, double h, double y) { return gdsr_test::square_cloth(side, h, y).mesh; }
 
 // Two meshes as one garment (UV of b shifted so the pattern pieces do not overlap).
 gdsr::GarmentMesh merge(const gdsr::GarmentMesh& a, const gdsr::GarmentMesh& b) {
