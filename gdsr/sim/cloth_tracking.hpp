@@ -11,8 +11,9 @@
 // The filter is the LR mesh itself. U (HR x LR) is the barycentric upsampling of the LR-HR
 // correspondence (gdsr/geometry/correspondence.hpp: hr_from_lr); its transpose, normalised by
 // each LR vertex's total weight W, averages HR vertices over each LR vertex's hat function:
-//   D = W^-1 U^T.  P = U D is the projection onto what the LR mesh can represent; W^-1 U^T U
-// is row-stochastic, so P's eigenvalues lie in [0, 1]. Each substep moves the HR positions x
+//   D = W^-1 U^T.  P = U D smooths a field down to what the LR mesh can represent (a low-pass
+//   filter, not an exact projection: P P != P). W^-1 U^T U is row-stochastic, so P's
+//   eigenvalues lie in [0, 1]. Each substep moves the HR positions x
 // and velocities v of free (unpinned) vertices by
 //   x += beta * P (U g - x),   v += beta * P (U g' - v),   beta = 1 - exp(-rate * h),
 // with g and g' the guide's LR positions and velocity at the start of the substep. A
