@@ -9,10 +9,10 @@
 // part the vertex was dressed on last, see pinch_separation), pinned bands (a waistband) moving
 // rigidly with the body under them (sim/cloth_pins.hpp),
 // inner/outer layer contact for multi-layer garments, long-range attachments to the pins
-// (sim/cloth_tethers.hpp), cloth self-contact (see
-// sim/cloth_self_collision.hpp), and for an HR simulation given its LR one, a pull towards it
-// at the LR scale (sim/cloth_tracking.hpp). Without a body, pinned vertices stay fixed in space. Sequential Gauss-Seidel in a
-// fixed order: the same inputs give bit-identical output. Units: metres, seconds, kg.
+// (sim/cloth_tethers.hpp), cloth self-contact (see sim/cloth_self_collision.hpp), and for an HR
+// simulation given its LR one, a pull towards it at the LR scale (sim/cloth_tracking.hpp).
+// Without a body, pinned vertices stay fixed in space. Sequential Gauss-Seidel in a fixed
+// order: the same inputs give bit-identical output. Units: metres, seconds, kg.
 // The body is Y-up (gravity along -y by default).
 #pragma once
 
