@@ -618,9 +618,9 @@ std::vector<Points3> simulate_frames(const Garment& g, const gdsr::Faces& body_F
   solver.set_damping(p.settle_damping);
   if (start) solver.set_positions(*start);
   const double blend_frames = std::max(1.0, p.settle_rest_blend * p.settle_frames);
+  if (guide) solver.set_guide(&guide->tracker, &guide->frames[0], &guide->frames[0]);  // the settle follows frame 0
   for (int k = 0; k < p.settle_frames; ++k) {
     solver.set_rest_blend(start ? 1.0 : std::min(1.0, (k + 1) / blend_frames));
-    if (guide) solver.set_guide(&guide->tracker, &guide->frames[0], &guide->frames[0]);
     solver.step(frames[0], frames[0], dt);
     if (progress) progress(++done, total);
   }
