@@ -17,7 +17,10 @@
 //     a mocap forearm passing into the trunk; the skin creasing at a bent joint does not
 //     count), and the pinch frames among them (the motion leaves the cloth no room);
 //   - agreement: distance of each HR vertex to the LR frame upsampled to HR topology through
-//     the dataset's correspondence (gdsr/geometry/correspondence.hpp);
+//     the dataset's correspondence (gdsr/geometry/correspondence.hpp), and split by scale with
+//     HR's own shape at the LR scale, S = upsample(downsample(HR)): |S - upsample(LR)| is a
+//     difference in drape, |HR - S| what the LR mesh cannot hold (wrinkles); the first is what
+//     a perfect correction E of GDSR can remove, the second what is left for the detail A;
 //   - wrinkles: mean absolute mean curvature of HR, LR upsampled and LR
 //     (gdsr/geometry/wrinkles.hpp).
 // Every figure is over all frames of the clip (rest-blend frames included). Units: metres,
@@ -94,6 +97,9 @@ struct ValidityFigures {
   double agreement_max = 0;   // the worst frame's mean
   int agreement_max_frame = -1;
   double agreement_rest = 0;            // the same on the canonical (rest) meshes
+  // The split by scale (header comment), means over the clip (NaN: figures written before it):
+  double agreement_lr_scale = 0;  // mean |upsample(downsample(HR)) - upsample(LR)|, metres
+  double detail = 0;              // mean |HR - upsample(downsample(HR))|, metres
   double upsampled_mean_curvature = 0;  // 1/m, LR upsampled to HR topology, mean over frames
   std::vector<FrameValidity> per_frame;  // the figures of each frame (not in the manifest)
   // HR / LR of a strain figure (NaN when LR's is below 1e-12)

@@ -89,6 +89,10 @@ TEST_CASE("gdsr: validity figures of a stretched, lifted sheet over a rising box
   CHECK(v.agreement_mean == doctest::Approx(0.002).epsilon(1e-9));
   CHECK(v.agreement_max == doctest::Approx(0.002).epsilon(1e-9));
   CHECK(v.agreement_rest < 1e-12);
+  // The 2 mm lift is a shift at the LR scale (barycentric down- and upsampling are exact on
+  // an affine shape): all drape, no wrinkles.
+  CHECK(v.agreement_lr_scale == doctest::Approx(0.002).epsilon(1e-9));
+  CHECK(v.detail < 1e-12);
   REQUIRE(v.body_measured);
   CHECK(v.lr.max_penetration == doctest::Approx(0.008).epsilon(1e-9));
   CHECK(v.lr.max_penetration_frame == 2);
@@ -118,6 +122,18 @@ TEST_CASE("gdsr: validity figures of a stretched, lifted sheet over a rising box
   CHECK(gdsr::validity_table(nb).find("not measured") != std::string::npos);
   CHECK(gdsr::validity_table(v).find("not measured") == std::string::npos);
   CHECK(gdsr::validity_table(v).find("max penetration") != std::string::npos);
+}
+
+TEST_CASE("gdsr: validity splits the agreement by scale: a ripple that vanishes on the LR vertices is all wrinkles") {
+  gdsr::Dataset d = stretched_dataset({0.0, 0.0});
+  // Flat HR (no lift) plus 3 mm times sin(pi x / 75 mm) of the rest x: zero on every LR vertex
+  // (75 mm apart) and +-3 mm on the HR vertices between them, so downsampling sees none of it.
+  for (auto& hr : d.hr_frames)
+    for (int i = 0; i < hr.rows(); ++i) hr(i, 2) = 0.003 * std::sin(M_PI * d.hr.V(i, 0) / 0.075);
+  const gdsr::ValidityFigures v = gdsr::measure_validity(d);
+  CHECK(v.agreement_lr_scale < 1e-12);
+  CHECK(v.detail == doctest::Approx(v.agreement_mean).epsilon(1e-12));
+  CHECK(v.detail == doctest::Approx(0.003 * 4 / 9).epsilon(1e-9));  // 4 of the 9 HR columns at 3 mm
 }
 
 TEST_CASE("gdsr: validity counts penetration under a second body part as a pinch") {
@@ -245,6 +261,11 @@ TEST_CASE("gdsr: validity wrinkles: HR ripples above LR upsampled / figures surv
   CHECK(v.upsampled_mean_curvature == doctest::Approx(up).epsilon(1e-12));
   CHECK(v.hr.mean_curvature > 1.5 * v.upsampled_mean_curvature);
   CHECK(v.agreement_mean > 0.001);  // the 4 mm HR ripples
+  // The two parts add up to at least the whole (triangle inequality per vertex), and the
+  // ripples show as wrinkles.
+  CHECK(v.agreement_lr_scale + v.detail >= v.agreement_mean - 1e-15);
+  CHECK(v.detail > 0.5 * v.agreement_mean);
+  CHECK(gdsr::validity_table(v).find("by scale") != std::string::npos);
 
   gdsr::Dataset w = d;
   w.manifest.validity = gdsr::validity_to_json(v);
@@ -263,6 +284,13 @@ TEST_CASE("gdsr: validity wrinkles: HR ripples above LR upsampled / figures surv
   const gdsr::ValidityFigures u = gdsr::validity_from_json(unsplit);
   CHECK(std::isnan(u.hr.strain.E_u_stretched));
   CHECK(gdsr::validity_table(u).find("stretched fibres") == std::string::npos);
+  // Figures written before the agreement was split by scale read NaN and print no split.
+  nlohmann::json unscaled = w.manifest.validity;
+  for (const char* k : {"lr_scale_mean", "finer_mean"}) unscaled["agreement_m"].erase(k);
+  const gdsr::ValidityFigures us = gdsr::validity_from_json(unscaled);
+  CHECK(std::isnan(us.agreement_lr_scale));
+  CHECK(std::isnan(us.detail));
+  CHECK(gdsr::validity_table(us).find("by scale") == std::string::npos);
   // A dataset written without figures (as before this field existed) loads with none.
   gdsr::write_dataset(dir / "old", d);
   CHECK(gdsr::load_dataset(dir / "old").manifest.validity.empty());
