@@ -32,6 +32,8 @@ gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d) {
       "moved by collision handling (body offset %.1f mm)\n",
       r.G.size(), r.seconds_per_frame, r.model_seconds_per_frame, static_cast<long long>(d.lr.V.rows()),
       static_cast<long long>(d.hr.V.rows()), pushed, 1000 * opt.collision.sigma_b);
+  std::printf("  model parts: correction E moves LR vertices %.2f mm, detail A moves HR vertices %.2f mm (mean)\n",
+              1000 * r.mean_correction, 1000 * r.mean_detail);
   return r;
 }
 

@@ -25,6 +25,9 @@ struct RolloutResult {
   std::vector<Points3> C_hat;  // per frame: LR vertices x 3, metres
   std::vector<Points3> G;      // per frame: HR vertices x 3, metres (after collision handling)
   std::vector<CollisionStats> collisions;
+  // How far each part of the model moves the garment, averaged over the frames, metres:
+  // E's correction, mean |C^ - C| over LR vertices; A's residual, mean |r| over HR vertices.
+  double mean_correction = 0, mean_detail = 0;
   double seconds_per_frame = 0;        // model + collision handling, wall time
   double model_seconds_per_frame = 0;  // model forward only
 };

@@ -146,6 +146,9 @@ void add_train_command(CLI::App& app) {
                  "push-forward: the history of a training frame is the model's own roll-out over the K frames "
                  "before it (0: the downsampled HR truth, teacher forcing)")
       ->capture_default_str();
+  c->add_flag("--rollout-from-truth", a->opt.rollout_from_truth,
+              "the push-forward roll-out starts from the downsampled HR truth before it, not from the LR input "
+              "(with --rollout-history)");
   c->add_flag("--detail-target", a->opt.detail_target,
               "fine loss against the HR frame's own detail on the model's coarse shape (default: the HR frame)");
   c->add_option("--lr", a->opt.lr, "AdamW learning rate")->capture_default_str();

@@ -23,6 +23,7 @@ nlohmann::json train_options_to_json(const TrainOptions& o) {
   j["max_steps"] = o.max_steps;
   j["frames_per_step"] = o.frames_per_step;
   j["rollout_history"] = o.rollout_history;
+  j["rollout_from_truth"] = o.rollout_from_truth;
   j["detail_target"] = o.detail_target;
   j["lr"] = o.lr;
   j["weight_decay"] = o.weight_decay;

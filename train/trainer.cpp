@@ -358,9 +358,11 @@ TrainLog train_step(TrainState& s, const TrainOptions& opt) {
     FrameLoss f;
     if (opt.rollout_history > 0) {  // push-forward: the history is the model's own, from a roll-out
       const int first = std::max(t - opt.rollout_history, 0);
-      const std::vector<Points3> pred = corrected_rollout(*s.model, seq.graph, *seq.d, seq.body.get(), first, t - first);
-      f = frame_loss(s, seq, t, rollout_history(*seq.d, pred, first, t, 1), rollout_history(*seq.d, pred, first, t, 2),
-                     lambdas, patch_rng, &noise, opt);
+      const std::vector<Points3>* before = opt.rollout_from_truth ? &seq.lr_truth : nullptr;
+      const std::vector<Points3> pred =
+          corrected_rollout(*s.model, seq.graph, *seq.d, seq.body.get(), first, t - first, before);
+      f = frame_loss(s, seq, t, rollout_history(*seq.d, pred, first, t, 1, before),
+                     rollout_history(*seq.d, pred, first, t, 2, before), lambdas, patch_rng, &noise, opt);
     } else {  // teacher forcing
       f = frame_loss(s, seq, t, seq.lr_truth[t - 1], seq.lr_truth[t - 2], lambdas, patch_rng, &noise, opt);
     }
@@ -500,6 +502,8 @@ void validate_train_options(const TrainOptions& opt) {
   if (opt.rollout_history < 0 || opt.rollout_history > 64)
     gdsr::fail("train", "--rollout-history must be 0 (teacher forcing) to 64 frames, got " +
                             std::to_string(opt.rollout_history));
+  if (opt.rollout_from_truth && opt.rollout_history == 0)
+    gdsr::fail("train", "--rollout-from-truth needs --rollout-history K > 0 (without it the history is the truth already)");
   if (!std::isfinite(opt.lr) || opt.lr <= 0) gdsr::fail("train", "--lr must be finite and > 0, got " + std::to_string(opt.lr));
   if (!std::isfinite(opt.lr_floor) || opt.lr_floor < 0) gdsr::fail("train", "the lr floor must be finite and >= 0");
   if (opt.lr_halve_every <= 0)

@@ -38,6 +38,9 @@ struct TrainOptions {
   // before t from the LR simulation as `gdsr infer` starts, so training sees the inputs a
   // roll-out feeds the model rather than the downsampled HR truth.
   int rollout_history = 0;
+  // Push-forward from the truth: the roll-out of rollout_history frames starts from the
+  // downsampled HR truth before it (false: from the LR input, d = 0, as a roll-out's first frame).
+  bool rollout_from_truth = false;
   // Fine-loss target (false: the HR frame, the reference): the HR frame's own detail carried
   // onto the model's coarse shape (train/detail_target.hpp), so that A is not asked to learn
   // the LR-HR drape difference. Validation's vertex error is always against the HR frame.

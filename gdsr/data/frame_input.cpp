@@ -33,24 +33,30 @@ FrameInput make_frame_input(const Dataset& d, int t, const Points3& chat_tm1, co
   return in;
 }
 
-const Points3& rollout_history(const Dataset& d, const std::vector<Points3>& pred, int first, int t, int back) {
+const Points3& rollout_history(const Dataset& d, const std::vector<Points3>& pred, int first, int t, int back,
+                               const std::vector<Points3>* before) {
   const int k = t - back - first;  // index of frame t - back among the predictions
   if (k >= 0) {
     if (k >= static_cast<int>(pred.size()))
       gdsr::fail("rollout_history", "frame " + std::to_string(t - back) + " has not been predicted yet");
     return pred[static_cast<size_t>(k)];
   }
-  return d.lr_frames[static_cast<size_t>(std::max(t - back, 0))];
+  const std::vector<Points3>& history = before ? *before : d.lr_frames;
+  if (history.size() != d.lr_frames.size())
+    gdsr::fail("rollout_history", "the history before the roll-out has " + std::to_string(history.size()) +
+                                      " frames, the dataset " + std::to_string(d.lr_frames.size()));
+  return history[static_cast<size_t>(std::max(t - back, 0))];
 }
 
 std::vector<Points3> corrected_rollout(const GDSR<float>& model, const GarmentGraph& graph, const Dataset& d,
-                                       BodyQuery* body, int first, int count) {
+                                       BodyQuery* body, int first, int count, const std::vector<Points3>* before) {
   ag::NoGradGuard no_grad;
   std::vector<Points3> pred;
   pred.reserve(static_cast<size_t>(std::max(count, 0)));
   for (int t = first; t < first + count; ++t) {
     const FrameInput in =
-        make_frame_input(d, t, rollout_history(d, pred, first, t, 1), rollout_history(d, pred, first, t, 2), body);
+        make_frame_input(d, t, rollout_history(d, pred, first, t, 1, before), rollout_history(d, pred, first, t, 2, before),
+                         body);
     pred.push_back(to_points(model.forward(graph, in, nullptr).C_hat));
   }
   return pred;

@@ -18,14 +18,17 @@ FrameInput make_frame_input(const Dataset& d, int t, const Points3& chat_tm1, co
 
 // The history C^_{t-back} (back = 1 or 2) of frame t in a roll-out that started at frame
 // `first`, where pred[i] is the corrected LR frame first + i. Before any prediction exists the
-// history is the LR simulation itself (d = 0), as at the start of `gdsr infer`.
-const Points3& rollout_history(const Dataset& d, const std::vector<Points3>& pred, int first, int t, int back);
+// history is `before` (per frame of d) if given, else the LR simulation itself (d = 0), as at
+// the start of `gdsr infer`.
+const Points3& rollout_history(const Dataset& d, const std::vector<Points3>& pred, int first, int t, int back,
+                               const std::vector<Points3>* before = nullptr);
 
 // The corrected LR frames C^ of frames first .. first + count - 1 rolled out by the model's
 // E alone (no HR request, no noise, no gradient): the push-forward history of training.
-// body: as for make_frame_input.
+// body: as for make_frame_input; before: the history before `first`, as for rollout_history.
 std::vector<Points3> corrected_rollout(const GDSR<float>& model, const GarmentGraph& graph, const Dataset& d,
-                                       BodyQuery* body, int first, int count);
+                                       BodyQuery* body, int first, int count,
+                                       const std::vector<Points3>* before = nullptr);
 
 // A BodyQuery on frame 0 of the dataset's body, or null without a body.
 std::unique_ptr<BodyQuery> make_body_query(const Dataset& d);

@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include "gdsr/data/frame_input.hpp"
+#include "gdsr/geometry/geometry_ad.hpp"
 #include "gdsr/model/model_config.hpp"
 #include "infer/rollout.hpp"
 #include "tests/support/data_fixtures.hpp"
@@ -51,6 +52,22 @@ TEST_CASE("rollout: a roll-out from a later frame starts from the LR simulation,
   CHECK(&gdsr::rollout_history(d, pred, 0, 0, 2) == &d.lr_frames[0]);  // clamped at the start
   CHECK_THROWS_WITH_AS(gdsr::rollout_history(d, pred, 3, 9, 1), doctest::Contains("has not been predicted"),
                        std::runtime_error);
+  // Training's push-forward may start from another history (the downsampled truth): frames
+  // before `first` come from it, the predicted ones from the roll-out.
+  std::vector<gdsr::Points3> truth;
+  for (const auto& hr : d.hr_frames) truth.push_back(gdsr::downsample(d.corr, hr));
+  CHECK(&gdsr::rollout_history(d, pred, 3, 4, 2, &truth) == &truth[2]);
+  CHECK(&gdsr::rollout_history(d, pred, 3, 4, 1, &truth) == &pred[0]);
+  const std::vector<gdsr::Points3> from_truth =
+      gdsr::corrected_rollout(model, gdsr::build_graph(d.lr), d, nullptr, 3, 4, &truth);
+  const gdsr::FrameInput in3 = gdsr::make_frame_input(d, 3, truth[2], truth[1], nullptr);
+  CHECK((from_truth[0] - gdsr::to_points(model.forward(gdsr::build_graph(d.lr), in3, nullptr).C_hat))
+            .cwiseAbs()
+            .maxCoeff() == 0.0);
+  CHECK((from_truth[0] - pred[0]).cwiseAbs().maxCoeff() > 0.0);
+  const std::vector<gdsr::Points3> short_history(truth.begin(), truth.begin() + 2);
+  CHECK_THROWS_WITH_AS(gdsr::rollout_history(d, pred, 3, 3, 1, &short_history), doctest::Contains("has 2 frames"),
+                       std::runtime_error);
 }
 
 TEST_CASE("rollout: ablations switch E (C^ = C) or A (G = upsampled C^) off, and nothing else") {
@@ -75,4 +92,26 @@ TEST_CASE("rollout: ablations switch E (C^ = C) or A (G = upsampled C^) off, and
     CHECK((no_a.C_hat[k] - full.C_hat[k]).cwiseAbs().maxCoeff() == 0.0);  // E untouched by switching A off
     CHECK((again.G[k] - full.G[k]).cwiseAbs().maxCoeff() == 0.0);         // switched back on: as before
   }
+}
+
+TEST_CASE("rollout: the mean moves of E and A are |C^ - C| and |G - upsampled C^|, zero when switched off") {
+  const gdsr::Dataset d = gdsr_test::wave_dataset(5);
+  gdsr::GDSR<float> model(gdsr::load_model_config(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json"));
+  gdsr::RolloutOptions o;
+  o.collisions = false;  // G is then upsampled C^ + A's residual exactly
+  const gdsr::RolloutResult full = gdsr::rollout(model, d, o);
+  double e = 0, a = 0;
+  const double T = static_cast<double>(d.lr_frames.size());
+  for (size_t k = 0; k < d.lr_frames.size(); ++k) {
+    e += (full.C_hat[k] - d.lr_frames[k]).rowwise().norm().mean() / T;
+    a += (full.G[k] - gdsr::upsample(d.corr, full.C_hat[k])).rowwise().norm().mean() / T;
+  }
+  CHECK(e > 1e-5);
+  CHECK(a > 1e-6);
+  CHECK(full.mean_correction == doctest::Approx(e).epsilon(1e-4));
+  CHECK(full.mean_detail == doctest::Approx(a).epsilon(1e-3));  // float G against a double upsample
+  model.set_ablation({false, false});
+  const gdsr::RolloutResult none = gdsr::rollout(model, d, o);
+  CHECK(none.mean_correction == 0.0);
+  CHECK(none.mean_detail == 0.0);
 }

@@ -81,18 +81,24 @@ TEST_CASE("trainer: push-forward feeds the model its own history, and validation
   o.validation = {&d};
   o.checkpoint_every = 3;
   gdsr_test::TempDir dir("trainer_push_forward");
-  auto first_step = [&](int K) {
+  auto first_step = [&](int K, bool from_truth = false) {
     o.rollout_history = K;
-    o.checkpoint = dir / ("k" + std::to_string(K) + ".ckpt");
+    o.rollout_from_truth = from_truth;
+    o.checkpoint = dir / ("k" + std::to_string(K) + (from_truth ? "t" : "") + ".ckpt");
     std::vector<gdsr::TrainLog> logs;
     gdsr::train_gdsr({&d}, o, [&](const gdsr::TrainLog& L) { logs.push_back(L); });
     REQUIRE(logs.size() == 3);
     return logs;
   };
-  const auto teacher = first_step(0), pushed = first_step(2), pushed_again = first_step(2);
+  const auto teacher = first_step(0), pushed = first_step(2), pushed_again = first_step(2),
+             from_truth = first_step(2, true);
   CHECK(std::isfinite(pushed[0].loss));
-  // The same frame and noise: only the history differs (the model's roll-out, not the HR truth).
+  CHECK(std::isfinite(from_truth[0].loss));
+  // The same frame and noise: only the history differs (the model's roll-out, not the HR truth;
+  // with --rollout-from-truth, the roll-out starts from the truth instead of the LR input).
   CHECK(pushed[0].loss != teacher[0].loss);
+  CHECK(from_truth[0].loss != teacher[0].loss);
+  CHECK(from_truth[0].loss != pushed[0].loss);
   for (size_t i = 0; i < 3; ++i) CHECK(pushed[i].loss == pushed_again[i].loss);  // deterministic
   // Validation rolls each clip out from frame 0 with the model's own history, so both runs are
   // scored the same way, on finite figures, next to the upsampled LR yardstick.

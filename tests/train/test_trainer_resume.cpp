@@ -167,6 +167,10 @@ TEST_CASE("trainer: bad options are refused before anything is written") {
       {"--frames-per-step must be positive", [](auto& o) { o.frames_per_step = 0; }},
       {"--rollout-history must be 0 (teacher forcing) to 64 frames, got -1", [](auto& o) { o.rollout_history = -1; }},
       {"--rollout-history must be 0 (teacher forcing) to 64 frames, got 65", [](auto& o) { o.rollout_history = 65; }},
+      {"--rollout-from-truth needs --rollout-history K > 0", [](auto& o) {
+         o.rollout_history = 0;
+         o.rollout_from_truth = true;
+       }},
       {"--lr must be finite and > 0, got nan", [nan](auto& o) { o.lr = nan; }},
       {"--lr must be finite and > 0, got -1", [](auto& o) { o.lr = -1; }},
       {"--lr must be finite and > 0, got inf", [](auto& o) { o.lr = std::numeric_limits<double>::infinity(); }},
