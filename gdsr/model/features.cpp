@@ -97,7 +97,13 @@ template <class T> GraphFeatures<T> compute_features(const GarmentGraph& g, cons
       r(i, 4 + k) = T(d);
       r(i, 7 + k) = T(vh);
     }
-  out.node = ag::concat_cols<T>({n, vel, acc, m_t, p_t, rest});
+  if (cfg.node_length_unit != 1.0) {
+    const T s = T(1.0 / cfg.node_length_unit);
+    out.node = ag::concat_cols<T>({n, ag::mul_scalar(vel, s), ag::mul_scalar(acc, s), ag::mul_scalar(m_t, s),
+                                   ag::mul_scalar(p_t, s), ag::mul_scalar(rest, s)});
+  } else {
+    out.node = ag::concat_cols<T>({n, vel, acc, m_t, p_t, rest});
+  }
 
   out.ring1 = edge_features(g.ring1_src, g.ring1_dst, C_t, in.C_tm1, g.ring1_rest);
   out.layer_edges = find_layer_edges(g, in.C_t, cfg.sigma_l);

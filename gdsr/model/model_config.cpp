@@ -85,6 +85,7 @@ void ModelConfig::validate() const {
   require("sigma_b", sigma_b, sigma_b > 0, "> 0 (metres)");
   require("sigma_l", sigma_l, sigma_l > 0, "> 0 (metres)");
   require("noise_std", noise_std, noise_std >= 0, ">= 0 (metres)");
+  require("node_length_unit", node_length_unit, node_length_unit > 0, "> 0 (metres)");
   require("frame_eps", frame_eps, frame_eps > 0 && frame_eps < 1, "in (0, 1) (relative to a triangle's size)");
   require("a_proj_init_gain", a_proj_init_gain, a_proj_init_gain > 0, "> 0");
   require("e_scale_init", e_scale_init, true, "finite");
@@ -95,7 +96,8 @@ void ModelConfig::validate() const {
   X(node_encoder_pre)                                                                                               \
   X(node_encoder_post) X(edge_encoder) X(mp_steps) X(layer_edge_mlps) X(h_norm) X(decoder) X(z_detail) X(e_widths)  \
       X(e_scale_init) X(a_widths) X(a_proj_init_gain) X(field_width) X(field_wire_layers) X(wire_omega0) X(wire_s0) \
-          X(field_scale_init) X(sigma_b) X(sigma_l) X(noise_std) X(frame_eps) X(seed)
+          X(field_scale_init) X(sigma_b) X(sigma_l) X(noise_std) X(node_length_unit) \
+              X(frame_eps) X(seed)
 
 ModelConfig model_config_from_json_text(const std::string& text, const std::string& origin) {
   json j;

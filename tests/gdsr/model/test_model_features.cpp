@@ -138,6 +138,20 @@ TEST_CASE("model features: two-triangle mesh against hand-computed values") {
     CHECK(diff > 0);
     CHECK(diff < 6 * 5 * cfg.noise_std);
   }
+
+  // node_length_unit 0.01 (centimetres): the 20 length columns are 100 times larger, the
+  // normals unchanged, the edges untouched.
+  ModelConfig cm = cfg;
+  cm.node_length_unit = 0.01;
+  in.has_body = true;
+  const auto f3 = compute_features<double>(g, ag::Tensor<double>::from_eigen(in.C_t), in, cm);
+  const auto n3 = f3.node.mat();
+  for (int i = 0; i < 4; ++i) {
+    for (int c = 0; c < 3; ++c) CHECK(n3(i, c) == n(i, c));
+    for (int c = 3; c < 23; ++c) CHECK(n3(i, c) == doctest::Approx(100 * n(i, c)).epsilon(1e-12));
+  }
+  CHECK(n3(0, 18) == doctest::Approx(0.2));  // d_{t-1} = 2 mm = 0.2 cm
+  CHECK((f3.ring1.mat() - e).cwiseAbs().maxCoeff() == 0.0);
 }
 
 TEST_CASE("model features: layer edges only for multi-layer garments") {

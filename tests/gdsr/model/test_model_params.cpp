@@ -98,6 +98,7 @@ TEST_CASE("model params: values outside the domain of the maths are refused nami
       {R"({"frame_eps": -1e-6})", "frame_eps"},  {R"({"frame_eps": 1.5})", "frame_eps"},
       {R"({"sigma_l": 0})", "sigma_l"},          {R"({"noise_std": -0.1})", "noise_std"},
       {R"({"field_width": -4})", "field_width"}, {R"({"e_widths": [1536, -128, 64]})", "e_widths"},
+      {R"({"node_length_unit": 0})", "node_length_unit"},
   };
   for (const auto& [text, key] : bad) {
     CAPTURE(text);
