@@ -43,6 +43,7 @@ template <class T> GDSR<T>::GDSR(const ModelConfig& cfg) : cfg_(cfg) {
   h_ = this->register_module("h", std::make_shared<MeshGraphNet<T>>(cfg, rng));
   e_ = this->register_module("e", std::make_shared<CorrectionDecoder<T>>(cfg, rng));
   a_ = this->register_module("a", std::make_shared<HyperNet<T>>(cfg, rng));
+  if (cfg.e_carry) carry = this->register_parameter("carry", ag::Tensor<T>::zeros({1, 1}));
 }
 
 template <class T> GdsrOutput<T> GDSR<T>::forward(const GarmentGraph& g, const FrameInput& in, const HrRequest* hr,
@@ -58,14 +59,20 @@ template <class T> GdsrOutput<T> GDSR<T>::forward(const GarmentGraph& g, const a
   t0 = Clock::now();
   const ag::Tensor<T> z = h_->forward(g, f);
   if (timings) timings->h += since(t0);
-  GdsrOutput<T> out = decode(g, C_t, z, hr, timings);
+  GdsrOutput<T> out;
+  if (cfg_.e_carry) {
+    const ag::Tensor<T> d_prev = to_tensor<T>(Points3(in.Chat_tm1 - in.C_tm1));
+    out = decode(g, C_t, z, hr, timings, &d_prev);
+  } else {
+    out = decode(g, C_t, z, hr, timings);
+  }
   out.features = std::move(f);
   return out;
 }
 
 template <class T> GdsrOutput<T> GDSR<T>::decode(const GarmentGraph& g, const ag::Tensor<T>& C_t,
                                                  const ag::Tensor<T>& z, const HrRequest* hr,
-                                                 GdsrTimings* timings) const {
+                                                 GdsrTimings* timings, const ag::Tensor<T>* d_prev) const {
   const int64_t V = g.num_vertices, zd = cfg_.z_detail;
   if (C_t.rows() != V || C_t.cols() != 3)
     gdsr::fail("gdsr_model", "C must be [V x 3], got " + ag::shape_str(C_t.shape()));
@@ -78,6 +85,11 @@ template <class T> GdsrOutput<T> GDSR<T>::decode(const GarmentGraph& g, const ag
   auto t0 = Clock::now();
   if (ablation_.correction) {
     out.D = e_->forward(g, ag::slice_cols(z, zd, z.cols()), C_t);
+    if (cfg_.e_carry && d_prev) {
+      if (d_prev->rows() != V || d_prev->cols() != 3)
+        gdsr::fail("gdsr_model", "the previous correction must be [V x 3], got " + ag::shape_str(d_prev->shape()));
+      out.D = ag::add(out.D, ag::mul(*d_prev, carry));  // [V x 3] * [1 x 1] broadcasts
+    }
     out.C_hat = ag::add(C_t, out.D);
   } else {
     out.D = ag::Tensor<T>::zeros({V, 3});

@@ -80,9 +80,12 @@ template <class T> class GDSR : public nn::Module<T> {
   // requiring grad to differentiate with respect to C.
   GdsrOutput<T> forward(const GarmentGraph& g, const ag::Tensor<T>& C_t, const FrameInput& in, const HrRequest* hr,
                         nn::Rng* noise = nullptr, GdsrTimings* timings = nullptr) const;
-  // E and A (and the composition) for a given latent z [V x (z_detail + z_disp)].
+  // E and A (and the composition) for a given latent z [V x (z_detail + z_disp)]; d_prev
+  // [V x 3]: the previous correction C^_{t-1} - C_{t-1}, used by the carry (ModelConfig::e_carry).
   GdsrOutput<T> decode(const GarmentGraph& g, const ag::Tensor<T>& C_t, const ag::Tensor<T>& z, const HrRequest* hr,
-                       GdsrTimings* timings = nullptr) const;
+                       GdsrTimings* timings = nullptr, const ag::Tensor<T>* d_prev = nullptr) const;
+
+  ag::Tensor<T> carry;  // [1 x 1] gamma, only with ModelConfig::e_carry
 
   void set_ablation(const GdsrAblation& a) { ablation_ = a; }
   const GdsrAblation& ablation() const { return ablation_; }

@@ -25,6 +25,13 @@ struct ModelConfig {
   // ---- Correction decoder E ----
   std::vector<int64_t> e_widths{384, 128, 256, 128, 64};  // MLP blocks, first = 3 * z_disp
   double e_scale_init = 0.1;                              // per-axis scale = init * randn(3)
+  // Carry: C^ = C + D + gamma d_{t-1}, with d_{t-1} = C^_{t-1} - C_{t-1} the previous
+  // correction (world) and gamma a learned scalar from 0. E's displacements live in each
+  // triangle's frame, the history in world axes: "keep the previous correction" is a product
+  // of inputs, which the MLPs did not learn (false: the reference, D alone). Measured on the
+  // small preset (models/README.md): teacher-forced, gamma rises to 0.45 and the one-step error
+  // falls to 0.66x of upsampling, but a roll-out, which has no true history, gets worse.
+  bool e_carry = false;
 
   // ---- Hyper-net A and the WIRE field ----
   std::vector<int64_t> a_widths{1536, 1024, 512, 256};  // MLP blocks, first = 3 * z_detail
