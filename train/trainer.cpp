@@ -503,7 +503,8 @@ void validate_train_options(const TrainOptions& opt) {
     gdsr::fail("train", "--rollout-history must be 0 (teacher forcing) to 64 frames, got " +
                             std::to_string(opt.rollout_history));
   if (opt.rollout_from_truth && opt.rollout_history == 0)
-    gdsr::fail("train", "--rollout-from-truth needs --rollout-history K > 0 (without it the history is the truth already)");
+    gdsr::fail("train",
+               "--rollout-from-truth needs --rollout-history K > 0 (without it the history is the truth already)");
   if (!std::isfinite(opt.lr) || opt.lr <= 0) gdsr::fail("train", "--lr must be finite and > 0, got " + std::to_string(opt.lr));
   if (!std::isfinite(opt.lr_floor) || opt.lr_floor < 0) gdsr::fail("train", "the lr floor must be finite and >= 0");
   if (opt.lr_halve_every <= 0)

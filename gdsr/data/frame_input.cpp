@@ -54,9 +54,8 @@ std::vector<Points3> corrected_rollout(const GDSR<float>& model, const GarmentGr
   std::vector<Points3> pred;
   pred.reserve(static_cast<size_t>(std::max(count, 0)));
   for (int t = first; t < first + count; ++t) {
-    const FrameInput in =
-        make_frame_input(d, t, rollout_history(d, pred, first, t, 1, before), rollout_history(d, pred, first, t, 2, before),
-                         body);
+    const FrameInput in = make_frame_input(d, t, rollout_history(d, pred, first, t, 1, before),
+                                           rollout_history(d, pred, first, t, 2, before), body);
     pred.push_back(to_points(model.forward(graph, in, nullptr).C_hat));
   }
   return pred;

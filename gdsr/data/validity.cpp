@@ -190,7 +190,7 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
     const double agree = mean_distance(d.hr_frames[t], up);
     const Points3 hr_coarse = upsample(d.corr, downsample(d.corr, d.hr_frames[t]));
     v.agreement_lr_scale += mean_distance(hr_coarse, up) / T;
-    v.detail += mean_distance(d.hr_frames[t], hr_coarse) / T;
+    v.agreement_finer += mean_distance(d.hr_frames[t], hr_coarse) / T;
     v.per_frame[t].agreement = agree;
     v.agreement_mean += agree / T;
     if (agree > v.agreement_max || v.agreement_max_frame < 0) {
@@ -334,7 +334,7 @@ nlohmann::json validity_to_json(const ValidityFigures& v) {
                         {"max_frame", v.agreement_max_frame},
                         {"rest", v.agreement_rest},
                         {"lr_scale_mean", v.agreement_lr_scale},
-                        {"finer_mean", v.detail}}},
+                        {"finer_mean", v.agreement_finer}}},
                       {"lr_upsampled_mean_curvature_1_m", v.upsampled_mean_curvature}};
   if (v.body_measured) j["body_crossing_frames"] = v.body_crossing_frames;
   return j;
@@ -357,7 +357,7 @@ ValidityFigures validity_from_json(const nlohmann::json& j) {
   v.agreement_rest = take<double>(a, "rest", "agreement_m.");
   const double nan = std::numeric_limits<double>::quiet_NaN();
   v.agreement_lr_scale = a.contains("lr_scale_mean") ? take<double>(a, "lr_scale_mean", "agreement_m.") : nan;
-  v.detail = a.contains("finer_mean") ? take<double>(a, "finer_mean", "agreement_m.") : nan;
+  v.agreement_finer = a.contains("finer_mean") ? take<double>(a, "finer_mean", "agreement_m.") : nan;
   v.upsampled_mean_curvature = take<double>(j, "lr_upsampled_mean_curvature_1_m", "");
   return v;
 }
@@ -449,7 +449,7 @@ std::string validity_table(const ValidityFigures& v) {
        1e3 * v.agreement_mean, 1e3 * v.agreement_max, v.agreement_max_frame, 1e3 * v.agreement_rest);
   if (std::isfinite(v.agreement_lr_scale))
     line("    by scale (HR downsampled and upsampled: S), mm: drape |S - LR upsampled| %.1f, wrinkles |HR - S| %.1f\n",
-         1e3 * v.agreement_lr_scale, 1e3 * v.detail);
+         1e3 * v.agreement_lr_scale, 1e3 * v.agreement_finer);
   return s;
 }
 

@@ -98,8 +98,8 @@ struct ValidityFigures {
   int agreement_max_frame = -1;
   double agreement_rest = 0;            // the same on the canonical (rest) meshes
   // The split by scale (header comment), means over the clip (NaN: figures written before it):
-  double agreement_lr_scale = 0;  // mean |upsample(downsample(HR)) - upsample(LR)|, metres
-  double detail = 0;              // mean |HR - upsample(downsample(HR))|, metres
+  double agreement_lr_scale = 0;        // mean |upsample(downsample(HR)) - upsample(LR)|, metres
+  double agreement_finer = 0;           // mean |HR - upsample(downsample(HR))|, metres
   double upsampled_mean_curvature = 0;  // 1/m, LR upsampled to HR topology, mean over frames
   std::vector<FrameValidity> per_frame;  // the figures of each frame (not in the manifest)
   // HR / LR of a strain figure (NaN when LR's is below 1e-12)

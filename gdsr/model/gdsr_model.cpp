@@ -71,8 +71,8 @@ template <class T> GdsrOutput<T> GDSR<T>::forward(const GarmentGraph& g, const a
 }
 
 template <class T> GdsrOutput<T> GDSR<T>::decode(const GarmentGraph& g, const ag::Tensor<T>& C_t,
-                                                 const ag::Tensor<T>& z, const HrRequest* hr,
-                                                 GdsrTimings* timings, const ag::Tensor<T>* d_prev) const {
+                                                 const ag::Tensor<T>& z, const HrRequest* hr, GdsrTimings* timings,
+                                                 const ag::Tensor<T>* d_prev) const {
   const int64_t V = g.num_vertices, zd = cfg_.z_detail;
   if (C_t.rows() != V || C_t.cols() != 3)
     gdsr::fail("gdsr_model", "C must be [V x 3], got " + ag::shape_str(C_t.shape()));

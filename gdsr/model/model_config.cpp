@@ -92,12 +92,12 @@ void ModelConfig::validate() const {
   require("field_scale_init", field_scale_init, true, "finite");
 }
 
-#define GDSR_CONFIG_FIELDS(X)                                                                                       \
-  X(node_encoder_pre)                                                                                               \
-  X(node_encoder_post) X(edge_encoder) X(mp_steps) X(layer_edge_mlps) X(h_norm) X(decoder) X(z_detail) X(e_widths)  \
-      X(e_scale_init) X(e_carry) X(a_widths) X(a_proj_init_gain) X(field_width) X(field_wire_layers) X(wire_omega0) X(wire_s0) \
-          X(field_scale_init) X(sigma_b) X(sigma_l) X(noise_std) X(node_length_unit) \
-              X(frame_eps) X(seed)
+#define GDSR_CONFIG_FIELDS(X)                                                                                  \
+  X(node_encoder_pre)                                                                                          \
+  X(node_encoder_post)                                                                                         \
+  X(edge_encoder) X(mp_steps) X(layer_edge_mlps) X(h_norm) X(decoder) X(z_detail) X(e_widths) X(e_scale_init)  \
+      X(e_carry) X(a_widths) X(a_proj_init_gain) X(field_width) X(field_wire_layers) X(wire_omega0) X(wire_s0) \
+          X(field_scale_init) X(sigma_b) X(sigma_l) X(noise_std) X(node_length_unit) X(frame_eps) X(seed)
 
 ModelConfig model_config_from_json_text(const std::string& text, const std::string& origin) {
   json j;

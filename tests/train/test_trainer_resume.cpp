@@ -167,7 +167,8 @@ TEST_CASE("trainer: bad options are refused before anything is written") {
       {"--frames-per-step must be positive", [](auto& o) { o.frames_per_step = 0; }},
       {"--rollout-history must be 0 (teacher forcing) to 64 frames, got -1", [](auto& o) { o.rollout_history = -1; }},
       {"--rollout-history must be 0 (teacher forcing) to 64 frames, got 65", [](auto& o) { o.rollout_history = 65; }},
-      {"--rollout-from-truth needs --rollout-history K > 0", [](auto& o) {
+      {"--rollout-from-truth needs --rollout-history K > 0",
+       [](auto& o) {
          o.rollout_history = 0;
          o.rollout_from_truth = true;
        }},
@@ -177,7 +178,8 @@ TEST_CASE("trainer: bad options are refused before anything is written") {
       {"loss weight c_smooth must be finite and >= 0", [](auto& o) { o.loss.c_smooth.weight = -1; }},
       {"loss weight f_position must be finite and >= 0", [nan](auto& o) { o.loss.f_position.weight = nan; }},
       {"loss weight lambda_c_start must be finite", [](auto& o) { o.loss.lambda_c_start = -0.5; }},
-      {"fewer frames than one step", [](auto& o) {
+      {"fewer frames than one step",
+       [](auto& o) {
          o.frames_per_step = 7;
          o.epochs = 1;
        }},

@@ -92,7 +92,7 @@ TEST_CASE("gdsr: validity figures of a stretched, lifted sheet over a rising box
   // The 2 mm lift is a shift at the LR scale (barycentric down- and upsampling are exact on
   // an affine shape): all drape, no wrinkles.
   CHECK(v.agreement_lr_scale == doctest::Approx(0.002).epsilon(1e-9));
-  CHECK(v.detail < 1e-12);
+  CHECK(v.agreement_finer < 1e-12);
   REQUIRE(v.body_measured);
   CHECK(v.lr.max_penetration == doctest::Approx(0.008).epsilon(1e-9));
   CHECK(v.lr.max_penetration_frame == 2);
@@ -132,8 +132,8 @@ TEST_CASE("gdsr: validity splits the agreement by scale: a ripple that vanishes 
     for (int i = 0; i < hr.rows(); ++i) hr(i, 2) = 0.003 * std::sin(M_PI * d.hr.V(i, 0) / 0.075);
   const gdsr::ValidityFigures v = gdsr::measure_validity(d);
   CHECK(v.agreement_lr_scale < 1e-12);
-  CHECK(v.detail == doctest::Approx(v.agreement_mean).epsilon(1e-12));
-  CHECK(v.detail == doctest::Approx(0.003 * 4 / 9).epsilon(1e-9));  // 4 of the 9 HR columns at 3 mm
+  CHECK(v.agreement_finer == doctest::Approx(v.agreement_mean).epsilon(1e-12));
+  CHECK(v.agreement_finer == doctest::Approx(0.003 * 4 / 9).epsilon(1e-9));  // 4 of the 9 HR columns at 3 mm
 }
 
 TEST_CASE("gdsr: validity counts penetration under a second body part as a pinch") {
@@ -263,8 +263,8 @@ TEST_CASE("gdsr: validity wrinkles: HR ripples above LR upsampled / figures surv
   CHECK(v.agreement_mean > 0.001);  // the 4 mm HR ripples
   // The two parts add up to at least the whole (triangle inequality per vertex), and the
   // ripples show as wrinkles.
-  CHECK(v.agreement_lr_scale + v.detail >= v.agreement_mean - 1e-15);
-  CHECK(v.detail > 0.5 * v.agreement_mean);
+  CHECK(v.agreement_lr_scale + v.agreement_finer >= v.agreement_mean - 1e-15);
+  CHECK(v.agreement_finer > 0.5 * v.agreement_mean);
   CHECK(gdsr::validity_table(v).find("by scale") != std::string::npos);
 
   gdsr::Dataset w = d;
@@ -289,7 +289,7 @@ TEST_CASE("gdsr: validity wrinkles: HR ripples above LR upsampled / figures surv
   for (const char* k : {"lr_scale_mean", "finer_mean"}) unscaled["agreement_m"].erase(k);
   const gdsr::ValidityFigures us = gdsr::validity_from_json(unscaled);
   CHECK(std::isnan(us.agreement_lr_scale));
-  CHECK(std::isnan(us.detail));
+  CHECK(std::isnan(us.agreement_finer));
   CHECK(gdsr::validity_table(us).find("by scale") == std::string::npos);
   // A dataset written without figures (as before this field existed) loads with none.
   gdsr::write_dataset(dir / "old", d);

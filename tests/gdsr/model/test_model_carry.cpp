@@ -38,8 +38,8 @@ TEST_CASE("model carry: zero at the start, gamma times the previous correction, 
   model.set_ablation({});
 
   // Central differences in float64; C^ is linear in gamma, so the step only meets round-off.
-  const auto r = ag::gradcheck(
-      [&](const std::vector<ag::Tensord>&) { return model.forward(g, in, nullptr).C_hat; }, {model.carry});
+  const auto r = ag::gradcheck([&](const std::vector<ag::Tensord>&) { return model.forward(g, in, nullptr).C_hat; },
+                               {model.carry});
   MESSAGE("carry: " << r.report());
   CHECK(r.max_rel_error < 1e-6);
 }
