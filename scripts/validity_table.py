@@ -30,6 +30,8 @@ def row(name, res, v, stats):
     speed = f"{wall:.3f} / {cpu:.3f}" if wall is not None and cpu is not None else "-"
     agree = v["agreement_m"]
     agreement = f'{1000 * agree["mean"]:.1f} / {1000 * agree["max_frame_mean"]:.1f}' if res == "hr" else ""
+    if res == "hr" and "lr_scale_mean" in agree:  # manifests from before the split by scale have none
+        agreement += f' (drape {1000 * agree["lr_scale_mean"]:.1f}, wrinkles {1000 * agree["finer_mean"]:.1f})'
     return (f'| {name} | {res.upper()} | {r["faces"]} | {100 * si["clean_fraction"]:.1f}% '
             f'({si["clean_frames"]}/{si["frames_checked"]}) | {si["median_pairs"]:g} / {si["max_pairs"]} '
             f'| {s["E_u"]:.5f} | {s["E_v"]:.5f} | {s["E_uv"]:.5f} | {pen} | {agreement} '
@@ -38,7 +40,7 @@ def row(name, res, v, stats):
 
 def main(dirs):
     print("| dataset | res | faces | clean frames (CGAL) | pairs median / max | E_u | E_v | E_uv "
-          "| max penetration mm (frames > 5 mm): all / outside pinches / pinch frames | HR-LR agreement mm mean / worst frame "
+          "| max penetration mm (frames > 5 mm): all / outside pinches / pinch frames | HR-LR agreement mm mean / worst frame (drape, wrinkles) "
           "| mean curvature 1/m | s/frame wall / CPU |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     status = 0
