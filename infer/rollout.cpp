@@ -7,22 +7,9 @@
 #include "gdsr/model/frames.hpp"
 
 #include <chrono>
-#include <cmath>
 #include <stdexcept>
 
 namespace gdsr {
-
-namespace {
-double mean_row_norm(const ag::Tensor<float>& x) {
-  if (x.rows() == 0) return 0.0;
-  double sum = 0;
-  for (int64_t i = 0; i < x.rows(); ++i) {
-    const float* p = x.data() + 3 * i;
-    sum += std::sqrt(double(p[0]) * p[0] + double(p[1]) * p[1] + double(p[2]) * p[2]);
-  }
-  return sum / static_cast<double>(x.rows());
-}
-}  // namespace
 
 RolloutResult rollout(const GDSR<float>& model, const Dataset& d, const RolloutOptions& opt,
                       const ProgressFn& progress) {
@@ -54,8 +41,8 @@ RolloutResult rollout(const GDSR<float>& model, const Dataset& d, const RolloutO
     model_secs += std::chrono::duration<double>(std::chrono::steady_clock::now() - m0).count();
     Points3 C_hat = to_points(out.C_hat);
     Points3 G = to_points(out.G);
-    r.mean_correction += mean_row_norm(out.D) / count;
-    r.mean_detail += mean_row_norm(out.residual) / count;
+    r.mean_correction += to_points(out.D).rowwise().norm().mean() / count;
+    r.mean_detail += to_points(out.residual).rowwise().norm().mean() / count;
 
     CollisionStats stats;
     if (opt.collisions) {

@@ -59,13 +59,9 @@ template <class T> GdsrOutput<T> GDSR<T>::forward(const GarmentGraph& g, const a
   t0 = Clock::now();
   const ag::Tensor<T> z = h_->forward(g, f);
   if (timings) timings->h += since(t0);
-  GdsrOutput<T> out;
-  if (cfg_.e_carry) {
-    const ag::Tensor<T> d_prev = to_tensor<T>(Points3(in.Chat_tm1 - in.C_tm1));
-    out = decode(g, C_t, z, hr, timings, &d_prev);
-  } else {
-    out = decode(g, C_t, z, hr, timings);
-  }
+  ag::Tensor<T> d_prev;  // the previous correction, for the carry only
+  if (cfg_.e_carry) d_prev = to_tensor<T>(Points3(in.Chat_tm1 - in.C_tm1));
+  GdsrOutput<T> out = decode(g, C_t, z, hr, timings, cfg_.e_carry ? &d_prev : nullptr);
   out.features = std::move(f);
   return out;
 }
