@@ -648,7 +648,7 @@ void add_data_command(CLI::App& app) {
       ->check(finite_range(0.0, 1.0));
   make->add_option("--track-rate", mk->track_rate,
                    "1/s: HR follows the LR simulation at the LR scale, a difference in drape decaying at this rate, "
-                   "and adds finer wrinkles (default: the solver's, 10; 0: independent, as before revision 13)")
+                   "and adds finer wrinkles (default: the solver's, 30; 0: independent, as before revision 13)")
       ->check(finite_range(0.0, 1000.0));
   make->add_option("--contact-every", mk->contact_every,
                    "substeps between body contact refreshes (default: the solver's)")

@@ -71,6 +71,7 @@ class SelfCollision {
   int num_edge_edge() const { return static_cast<int>(ee_.size()); }
   // Vertices of edges and triangles found crossing each other at the last tangle test.
   int num_tangled_vertices() const;
+  const std::vector<char>& tangled() const { return tangled_; }  // per vertex, 1: tangled (as above)
   // Edge-triangle pairs (no shared vertex) found crossing at the last tangle test.
   int num_intersecting_pairs() const { return intersecting_; }
   long long num_detections() const { return detections_; }  // since construction

@@ -384,15 +384,20 @@ void ClothSolver::detect_self_contacts(double h) {
   if (!self_ || since_detect_ < detect_interval_) return;
   const int nv = static_cast<int>(x_.rows());
   std::vector<double> speed(nv);
-  for (int v = 0; v < nv; ++v) speed[v] = v_.row(v).norm();
+  // The guide's pull (track_guide) moves the cloth too: left out of the motion, a pair it pushed
+  // across looked like an intersection that had slipped through, and was freed.
+  const bool pulled = pull_step_.rows() == nv;
+  for (int v = 0; v < nv; ++v) speed[v] = pulled ? (v_.row(v) + pull_step_.row(v) / h).norm() : v_.row(v).norm();
   const int q = std::min(nv - 1, nv * 99 / 100);
   std::nth_element(speed.begin(), speed.begin() + q, speed.end());
   const double pad = 0.5 * p_.self_thickness + p_.self_slack;
   detect_interval_ = p_.self_detect_every;
   while (detect_interval_ > 1 && speed[q] * detect_interval_ * h > 2 * pad) detect_interval_ = (detect_interval_ + 1) / 2;
   const double T = detect_interval_ * h;
-  for (int v = 0; v < nv; ++v)
+  for (int v = 0; v < nv; ++v) {
     motion_.row(v) = v_.row(v) * T + (winv_[v] == 0 ? 0.0 : 0.5 * T * T) * p_.gravity.transpose();
+    if (pulled) motion_.row(v) += detect_interval_ * pull_step_.row(v);
+  }
   self_->detect(x_, motion_, p_.self_slack, p_.self_thickness, tangle_test_due_);
   tangle_test_due_ = false;
   x_detect_ = x_;
@@ -541,10 +546,22 @@ void ClothSolver::set_guide(const GuideTracker* tracker, const Points3* from, co
 }
 
 void ClothSolver::track_guide(double a0, double dt, double h) {
-  if (!tracker_ || !(p_.track_rate > 0)) return;
+  if (!tracker_ || !(p_.track_rate > 0)) {
+    pull_step_.resize(0, 3);
+    return;
+  }
   const Points3 g = (1 - a0) * *guide_from_ + a0 * *guide_to_;
   const Points3 gv = (*guide_to_ - *guide_from_) / dt;
-  tracker_->pull(g, gv, 1 - std::exp(-p_.track_rate * h), winv_, x_, v_);
+  // Cloth that went through itself is left to untangling; three rings of edges are about one LR
+  // particle distance (30 mm) at 10 mm.
+  constexpr int kTrackFreeRings = 3;
+  const double beta = 1 - std::exp(-p_.track_rate * h);
+  const Points3 before = x_;
+  if (!self_ || self_->num_tangled_vertices() == 0)
+    tracker_->pull(g, gv, beta, winv_, x_, v_);
+  else
+    tracker_->pull(g, gv, beta, untangled_pull_weights(winv_, self_->tangled(), F_, kTrackFreeRings), x_, v_);
+  pull_step_ = x_ - before;
 }
 
 void ClothSolver::step(const Points3& body_from, const Points3& body_to, double dt) {

@@ -79,7 +79,14 @@ namespace sim {
 //     sim/cloth_tracking.hpp): run independently, the chaotic drape of a dance or a walk kept
 //     the two 21-38 mm apart on average, so "HR minus upsampled LR" was mostly a different drape,
 //     not wrinkles. LR frames, and everything simulated without a guide, are unchanged, bit for bit.
-inline constexpr int kSolverRevision = 13;
+// 14: the HR pull respects self-contact: the detection counts it in each vertex's motion (a pair
+//     pushed across by the pull looked like an intersection that had slipped through, and was
+//     freed), and cloth that went through itself, with a few edges around it, is left to
+//     untangling. At 30/s skirt_short on salsa 61_02 (2-6 s) had a knot for 14 frames (89.0% of
+//     HR frames clean); 100% now. `data make`'s default rate is 30/s, not 10
+//     (SimParams::track_rate). LR frames, and anything simulated without a guide, are unchanged,
+//     bit for bit.
+inline constexpr int kSolverRevision = 14;
 
 struct SimParams {
   int substeps = 20;                // per body frame
@@ -156,11 +163,14 @@ struct SimParams {
   int stretch_passes = 4;         // stretch (+ tether) passes per iteration: cheap (~1% of a substep each)
   bool tethers = true;            // long-range attachments to the pins (sim/cloth_tethers.hpp)
   double tether_stretch = 0.002;  // stretch a tether allows beyond the rest distance along the cloth (0.2%)
-  double track_rate = 10;         // 1/s: with a guide (`data make` gives HR its LR simulation), how fast a
+  double track_rate = 30;         // 1/s: with a guide (`data make` gives HR its LR simulation), how fast a
                                   // difference in drape at the LR scale decays (sim/cloth_tracking.hpp); 0:
                                   // independent. skirt_short on salsa 61_02 (2-4 s), rates 0 / 2 / 5 / 10 / 20:
                                   // HR-LR agreement 30.8 / 23.1 / 16.9 / 11.2 / 7.0 mm, HR curvature 1.52 / 1.48 /
-                                  // 1.41 / 1.36 / 1.31x the upsampled LR's, the same seconds per frame
+                                  // 1.41 / 1.36 / 1.31x the upsampled LR's, the same seconds per frame. Rates 10 /
+                                  // 30 / 100 split it into drape 10.8 / 4.8 / 1.8 mm and wrinkles 1.8 / 1.7 / 1.6 mm:
+                                  // 30 keeps the folds and most of the drape of LR (10, revision 13's default,
+                                  // until 2026-11-28, left a drape a model cannot predict; 100 crumples HR)
 };
 
 // An LR simulation for an HR one to follow (SimParams::track_rate): the tracker holds the
@@ -271,6 +281,7 @@ class ClothSolver {
   double body_cell_ = 0.05;
   std::unique_ptr<SelfCollision> self_;
   gdsr::Points3 x_detect_;      // positions at the last self-contact detection
+  gdsr::Points3 pull_step_;     // the guide's last pull of x_ (track_guide), metres per substep
   gdsr::Points3 motion_;        // m, per vertex: predicted motion until the next detection
   int since_detect_ = 1 << 30;  // substeps since the last detection
   int detect_interval_ = 1;     // substeps the last detection covers (self_detect_every or fewer for fast cloth)

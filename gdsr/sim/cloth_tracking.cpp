@@ -42,4 +42,21 @@ void GuideTracker::pull(const Points3& guide_x, const Points3& guide_v, double b
   }
 }
 
+std::vector<double> untangled_pull_weights(const std::vector<double>& winv, const std::vector<char>& tangled,
+                                           const gdsr::Faces& F, int rings) {
+  if (tangled.size() != winv.size() || (F.size() > 0 && F.maxCoeff() >= static_cast<int>(winv.size())))
+    gdsr::fail("sim/cloth_tracking", "tangled flags or faces do not match the vertex count");
+  std::vector<char> near = tangled;
+  for (int ring = 0; ring < rings; ++ring) {
+    std::vector<char> grown = near;
+    for (int f = 0; f < F.rows(); ++f)
+      if (near[F(f, 0)] || near[F(f, 1)] || near[F(f, 2)]) grown[F(f, 0)] = grown[F(f, 1)] = grown[F(f, 2)] = 1;
+    near.swap(grown);
+  }
+  std::vector<double> w = winv;
+  for (size_t i = 0; i < w.size(); ++i)
+    if (near[i]) w[i] = 0;
+  return w;
+}
+
 }  // namespace sim

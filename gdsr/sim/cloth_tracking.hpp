@@ -19,7 +19,9 @@
 // with g and g' the guide's LR positions and velocity at the start of the substep. A
 // wrinkle finer than the LR mesh (hat-weighted mean zero) is not touched; a difference in drape
 // decays with the time constant 1 / rate. The move comes before contacts are solved, so body
-// and self-contact still have the last word.
+// and self-contact still have the last word: the self-contact detection counts the pull in each
+// vertex's motion (ClothSolver::pull_step_), and cloth that went through itself is not pulled
+// (untangled_pull_weights), or the pull pressed a fold the LR mesh does not have back into a knot.
 #pragma once
 
 #include "gdsr/geometry/correspondence.hpp"
@@ -45,5 +47,12 @@ class GuideTracker {
   gdsr::Correspondence corr_;
   std::vector<double> weight_;  // W: per LR vertex, the sum of its barycentric weights over HR vertices
 };
+
+// The weights for GuideTracker::pull that leave cloth which went through itself to untangling
+// (SelfCollision::untangle): winv, with 0 at the tangled vertices (1 in `tangled`) and at every
+// vertex within `rings` edges of one on the mesh F (faces x 3). Pulled, the layers of a fold
+// the LR mesh does not have were pressed back together, and a small knot lasted 14 frames.
+std::vector<double> untangled_pull_weights(const std::vector<double>& winv, const std::vector<char>& tangled,
+                                           const gdsr::Faces& F, int rings);
 
 }  // namespace sim

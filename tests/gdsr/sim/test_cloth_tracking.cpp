@@ -1,5 +1,6 @@
 #include <doctest/doctest.h>
 
+#include "gdsr/error.hpp"
 #include "gdsr/geometry/correspondence.hpp"
 #include "gdsr/geometry/triangle.hpp"
 #include "gdsr/geometry/wrinkles.hpp"
@@ -8,8 +9,10 @@
 #include "tests/support/cloth_bodies.hpp"
 #include "tests/support/square_cloth.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 using gdsr::Points3;
 using gdsr::Vec3;
@@ -83,12 +86,74 @@ TEST_CASE("cloth tracking: the pull moves what the LR mesh can hold by beta and 
   CHECK(fine < 0.3);
 }
 
+TEST_CASE("cloth tracking: cloth that went through itself, and three rings of edges around it, is not pulled") {
+  const sim::Garment lr = square_cloth(0.6, 0.03, 0), hr = square_cloth(0.6, 0.01, 0);
+  const gdsr::Correspondence c = gdsr::compute_correspondence(lr.mesh, hr.mesh);
+  const sim::GuideTracker tracker(c);
+  const gdsr::Faces& F = hr.mesh.F;
+  const int n = static_cast<int>(hr.mesh.V.rows());
+  int centre = 0;
+  hr.mesh.V.rowwise().norm().minCoeff(&centre);
+  std::vector<char> tangled(static_cast<size_t>(n), 0);
+  tangled[static_cast<size_t>(centre)] = 1;
+  const std::vector<double> winv(static_cast<size_t>(n), 1.0);
+  const std::vector<double> w = sim::untangled_pull_weights(winv, tangled, F, 3);
+
+  // Yardstick: edge hops from the tangled vertex by breadth-first search over the faces' edges.
+  std::vector<std::vector<int>> adj(static_cast<size_t>(n));
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      adj[static_cast<size_t>(a)].push_back(b);
+      adj[static_cast<size_t>(b)].push_back(a);
+    }
+  std::vector<int> hops(static_cast<size_t>(n), -1), queue{centre};
+  hops[static_cast<size_t>(centre)] = 0;
+  for (size_t q = 0; q < queue.size(); ++q)
+    for (int j : adj[static_cast<size_t>(queue[q])])
+      if (hops[static_cast<size_t>(j)] < 0) {
+        hops[static_cast<size_t>(j)] = hops[static_cast<size_t>(queue[q])] + 1;
+        queue.push_back(j);
+      }
+  int held = 0, wrong = 0;
+  for (int i = 0; i < n; ++i) {
+    const bool near = hops[static_cast<size_t>(i)] >= 0 && hops[static_cast<size_t>(i)] <= 3;
+    held += near;
+    wrong += w[static_cast<size_t>(i)] != (near ? 0.0 : 1.0);
+  }
+  MESSAGE(held << " of " << n << " vertices held");
+  CHECK(held >= 19);  // at least the vertex and its first ring on a mesh of mostly six neighbours
+  CHECK(wrong == 0);
+
+  // Pulled by a rigid offset, the held vertices stay and the others move by beta of it.
+  const Points3 target = gdsr::upsample(c, lr.mesh.V);
+  const Vec3 offset(0.01, -0.02, 0.005);
+  Points3 x = target.rowwise() + offset.transpose(), v = Points3::Zero(n, 3);
+  const Points3 x0 = x;
+  tracker.pull(lr.mesh.V, Points3::Zero(lr.mesh.V.rows(), 3), 0.25, w, x, v);
+  double held_moved = 0, free_error = 0;
+  for (int i = 0; i < n; ++i) {
+    const double moved = (x.row(i) - x0.row(i)).norm();
+    if (w[static_cast<size_t>(i)] == 0)
+      held_moved = std::max(held_moved, moved);
+    else
+      free_error = std::max(free_error, std::abs(moved - 0.25 * offset.norm()));
+  }
+  CHECK(held_moved == 0);
+  CHECK(free_error < 1e-12);
+
+  // No tangle: the weights are winv itself; flags of the wrong length are refused.
+  CHECK(sim::untangled_pull_weights(winv, std::vector<char>(static_cast<size_t>(n), 0), F, 3) == winv);
+  CHECK_THROWS_AS(sim::untangled_pull_weights(winv, std::vector<char>(3, 0), F, 3), gdsr::Error);
+}
+
 TEST_CASE("cloth tracking: a tracked HR drape follows the LR one and keeps finer folds") {
   // A 0.7 m square dropped on a sphere (r 0.2 m) for 1 s at 30 and 10 mm. Independent, the
-  // folds around the rim buckle where each mesh's own noise puts them; tracked at 10/s, the HR
-  // sheet lies on the LR one at the LR scale and still folds more finely. The distance to the
-  // LR surface cannot fall to zero: the finer folds themselves stand off it (measured here:
-  // 6.1 mm independent, 4.1 mm tracked; curvature 1.33x and 1.20x the upsampled LR's).
+  // folds around the rim buckle where each mesh's own noise puts them; tracked at the solver's
+  // default rate (SimParams::track_rate), the HR sheet lies on the LR one at the LR scale and
+  // still folds more finely. The distance to the LR surface cannot fall to zero: the finer
+  // folds themselves stand off it (measured here: 6.1 mm independent, 2.0 mm tracked at 30/s,
+  // 4.1 mm at 10/s; curvature 1.33x, 1.17x and 1.20x the upsampled LR's).
   const double r = 0.2;
   const auto sphere = sim::make_sphere(Vec3(0, 0, 0), r, 32, 64);
   const sim::Garment lr = square_cloth(0.7, 0.03, r + 0.03), hr = square_cloth(0.7, 0.01, r + 0.03);
@@ -104,7 +169,8 @@ TEST_CASE("cloth tracking: a tracked HR drape follows the LR one and keeps finer
 
   const auto independent = sim::simulate_frames(hr, sphere.F, body, 30.0, p);
   sim::SimParams pt = p;
-  pt.track_rate = 10;
+  pt.track_rate = sim::SimParams().track_rate;
+  REQUIRE(pt.track_rate > 0);
   const auto tracked = sim::simulate_frames(hr, sphere.F, body, 30.0, pt, {}, nullptr, &guide);
   REQUIRE(tracked.back().allFinite());
   const Points3& L = lr_frames.back();
