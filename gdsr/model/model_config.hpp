@@ -49,8 +49,9 @@ struct ModelConfig {
   // Metres per unit of the node features that are lengths (velocity, acceleration, body
   // interaction, previous correction and corrected velocity); 1 is the reference's metres.
   // Those features are millimetres to centimetres next to unit normals, and the node encoder
-  // mixes them all in its first layer. At 1 the shipped small model ignores its history (its
-  // output moves 0.01 mm for a 4 mm change of the previous correction); trained at 0.01, 0.3 mm.
+  // mixes them all in its first layer. At 1 the small model shipped for revision 13 data ignored
+  // its history (its output moved 0.01 mm for a 4 mm change of the previous correction);
+  // trained at 0.01, 0.3 mm (models/README.md).
   double node_length_unit = 1.0;
   double frame_eps = 1e-2;   // local-frame normalisation eps, relative to each triangle's size (frames.hpp)
 

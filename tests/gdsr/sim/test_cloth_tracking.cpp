@@ -2,6 +2,7 @@
 
 #include "gdsr/error.hpp"
 #include "gdsr/geometry/correspondence.hpp"
+#include "gdsr/geometry/mesh_ops.hpp"
 #include "gdsr/geometry/triangle.hpp"
 #include "gdsr/geometry/wrinkles.hpp"
 #include "gdsr/sim/cloth_solver.hpp"
@@ -99,22 +100,18 @@ TEST_CASE("cloth tracking: cloth that went through itself, and three rings of ed
   const std::vector<double> winv(static_cast<size_t>(n), 1.0);
   const std::vector<double> w = sim::untangled_pull_weights(winv, tangled, F, 3);
 
-  // Yardstick: edge hops from the tangled vertex by breadth-first search over the faces' edges.
-  std::vector<std::vector<int>> adj(static_cast<size_t>(n));
-  for (int f = 0; f < F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = F(f, k), b = F(f, (k + 1) % 3);
-      adj[static_cast<size_t>(a)].push_back(b);
-      adj[static_cast<size_t>(b)].push_back(a);
-    }
+  // Yardstick: edge hops from the tangled vertex by breadth-first search over ring-1 neighbours.
+  const gdsr::Csr nb = gdsr::vertex_neighbours(F, n);
   std::vector<int> hops(static_cast<size_t>(n), -1), queue{centre};
   hops[static_cast<size_t>(centre)] = 0;
   for (size_t q = 0; q < queue.size(); ++q)
-    for (int j : adj[static_cast<size_t>(queue[q])])
+    for (int k = nb.offsets[queue[q]]; k < nb.offsets[queue[q] + 1]; ++k) {
+      const int j = nb.items[static_cast<size_t>(k)];
       if (hops[static_cast<size_t>(j)] < 0) {
         hops[static_cast<size_t>(j)] = hops[static_cast<size_t>(queue[q])] + 1;
         queue.push_back(j);
       }
+    }
   int held = 0, wrong = 0;
   for (int i = 0; i < n; ++i) {
     const bool near = hops[static_cast<size_t>(i)] >= 0 && hops[static_cast<size_t>(i)] <= 3;
