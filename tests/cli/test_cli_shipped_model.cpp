@@ -34,7 +34,7 @@ TEST_CASE("cli shipped model: on an unseen motion it beats the upsampled LR, sta
   MESSAGE("vertex error " << 1000 * err << " mm, upsampled LR " << 1000 * up << " mm; SSIM " << m.at("ssim").get<double>()
                           << " vs " << m.at("ssim_lr").get<double>() << "; E_u " << m.at("energies").at("E_u").get<double>());
   REQUIRE(std::isfinite(err));
-  CHECK(err < 0.9 * up);  // 0.85x on this 1 s clip, 0.84x on the whole 2 s one (models/README.md)
+  CHECK(err < 0.88 * up);  // 0.83x on this 1 s clip, 0.82x on the whole 2 s one (models/README.md)
   CHECK(m.at("ssim").get<double>() > m.at("ssim_lr").get<double>());
   for (const auto& f : r.at("per_frame")) {                // every frame, not only the mean
     CHECK(f.at("energies").at("E_u").get<double>() < 0.04);  // the paper's range: 0.01-0.04
