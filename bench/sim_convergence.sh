@@ -4,7 +4,10 @@
 # one table of their validity figures (scripts/validity_table.py). Its "HR-LR agreement"
 # column is the mean distance between the HR frame and the upsampled LR frame: if the coarse
 # shape converges, it falls as the LR distance approaches the HR one, and what remains at
-# 30 mm is the discretisation error of the LR simulation, not a different drape.
+# 30 mm is the discretisation error of the LR simulation, not a different drape. The HR runs
+# on its own (--track-rate 0): an HR that tracks its LR (data make's default since solver
+# revision 13) follows whichever LR it is paired with, and the column would measure the
+# tracking instead of the solver.
 # Then the floor under that figure: the first dataset made again with the friction nudged by
 # 1e-5 (0.003%), compared with it frame by frame (`gdsr data compare`). Where the motion
 # itself amplifies so small a difference to centimetres (a chaotic swing after a jump), no
@@ -27,7 +30,7 @@ make() {  # make DIR LR_PD [extra flags]
   shift 2
   echo "simulating $garment, LR $pd m / HR 0.01 m $* -> $d" >&2
   OMP_NUM_THREADS=1 "$build/gdsr" data make --garment "$garment" --motion "$motion" --start "$start" \
-    --seconds "$seconds" --lr-pd "$pd" --hr-pd 0.01 --out "$d" "$@" > "$d.log" 2>&1 ||
+    --seconds "$seconds" --lr-pd "$pd" --hr-pd 0.01 --track-rate 0 --out "$d" "$@" > "$d.log" 2>&1 ||
     { echo "gdsr data make failed, see $d.log" >&2; exit 1; }
 }
 dirs=""
