@@ -13,6 +13,13 @@
 #   whose figures stay inside this spread is not measured by one run of each: the 10 mm pants
 #   on 131_02 gave 44.1%, 100% and 97.1% of HR frames free of self-intersections (revision 12):
 #     bench/sim_sweep.sh build OUT --friction "0.3 0.30001 0.30002" pants ../shared/motions/cmu-walk/131_02.bvh
+#   At revision 14, skirt_short on salsa 61_03 (2-6 s): 125, 134 and 135 of 136 HR frames clean
+#   (frame 53, and frames 96-105 where the skirt, flipped up in a turn, folds at the waistband
+#   next to the hand); on 01_01 (1-5 s) 134, 136 and 136. Every setting tried on 61_03 falls inside that
+#   spread: --substeps 30 136 (133 with the friction nudged, and 2 LR frames unclean),
+#   --self-thickness 0.004 135, --iterations 3 130, --untangle-step 0.3 129, --self-slack-per-pd
+#   0.3 126, --self-detect-every 2 125 (bit-identical: on this dance the cloth's speed always cut the
+#   detection interval to 2 substeps or fewer).
 # - tracking: how closely the HR simulation follows the LR one (0: independent), agreement
 #   against the wrinkles HR adds (curvature over the upsampled LR's), and the cost:
 #     bench/sim_sweep.sh build OUT --track-rate "0 2 5 10" skirt_short /usr/share/assimp/models/BVH/01_01.bvh 1 2

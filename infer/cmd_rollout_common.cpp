@@ -22,6 +22,7 @@ gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d) {
   gdsr::RolloutOptions opt = a.opt;
   opt.collisions = !a.no_collisions;
   opt.collision.sigma_b = gdsr::body_offset_for(d.manifest.sim_params, a.body_offset);
+  opt.collision.hr_planes = !a.lr_body_planes;
   gdsr::ProgressBar bar("roll-out");
   gdsr::RolloutResult r = gdsr::rollout(model, d, opt, bar.callback());
   bar.finish();
@@ -118,6 +119,9 @@ void add_rollout_options(CLI::App* c, RolloutArgs& a, bool data_required) {
                 "metres the collision handling keeps the HR garment off the body (default: the dataset's simulation "
                 "thickness, else the paper's 0.015)")
       ->check(CLI::Range(0.0, 0.1));
+  c->add_flag("--lr-body-planes", a.lr_body_planes,
+              "collision handling as in the paper: HR vertices pushed out of the tangent plane of their nearest LR "
+              "vertex's body point (default: each its own, exact on a curved body)");
   c->add_option("--ablate", a.ablate,
                 "switch a part of the model off (repeatable): correction (C^ = C, no E) or detail (G = upsampled "
                 "C^, no A)")

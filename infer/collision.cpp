@@ -57,6 +57,27 @@ int push_group(const Groups& g, int i, const Vec3& p, const Vec3& n, double sigm
   return moved;
 }
 
+// Moves each HR vertex in `rows` out of its own closest body point's tangent plane to offset
+// sigma (one query for all of them); returns the moved count.
+int push_own_planes(const std::vector<int>& rows, const BodyQueryFn& body, double sigma, Points3& G) {
+  Points3 q(static_cast<Eigen::Index>(rows.size()), 3), b, n;
+  for (size_t k = 0; k < rows.size(); ++k) q.row(static_cast<Eigen::Index>(k)) = G.row(rows[k]);
+  body(q, b, n);
+  if (b.rows() != q.rows() || n.rows() != q.rows())
+    gdsr::fail("collision", "body query returned the wrong number of rows");
+  int moved = 0;
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const Eigen::Index r = static_cast<Eigen::Index>(k);
+    const Vec3 x = q.row(r).transpose(), nb = n.row(r).transpose();
+    const double m = sigma - (x - b.row(r).transpose()).dot(nb);
+    if (m > 0) {
+      G.row(rows[k]) = (x + m * nb).transpose();
+      ++moved;
+    }
+  }
+  return moved;
+}
+
 }  // namespace
 
 double body_offset_for(const nlohmann::json& sim_params, double given) {
@@ -99,13 +120,20 @@ CollisionStats resolve_collisions(const CollisionConfig& cfg, const CollisionInp
     (*in.body)(C, b, n);
     if (b.rows() != nl || n.rows() != nl) gdsr::fail("collision", "body query returned the wrong number of rows");
     st.body_queried = true;
+    std::vector<int> candidates;  // HR vertices of colliding LR vertices (hr_planes)
     for (int i = 0; i < nl; ++i) {
       const Vec3 p = b.row(i).transpose(), nb = n.row(i).transpose();
       if (cfg.sigma_b - (C.row(i).transpose() - p).dot(nb) > 0) {
         ++st.lr_body;
-        st.hr_body += push_group(groups, i, p, nb, cfg.sigma_b, G);
+        if (cfg.hr_planes)
+          candidates.insert(candidates.end(), groups.items.begin() + groups.offsets[i],
+                            groups.items.begin() + groups.offsets[i + 1]);
+        else
+          st.hr_body += push_group(groups, i, p, nb, cfg.sigma_b, G);
       }
     }
+    if (!candidates.empty()) st.hr_body += push_own_planes(candidates, *in.body, cfg.sigma_b, G);
+    st.hr_queried = static_cast<int>(candidates.size());
   }
 
   if (do_layers) {

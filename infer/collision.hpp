@@ -4,8 +4,14 @@
 //
 // Body: LR vertex i collides when sigma_b - (c^_i - b_i) . n_i > 0, with b_i / n_i its
 //   closest body point and that point's outward normal. Each HR vertex k whose nearest LR
-//   vertex in UV is a colliding i moves to g_k + max(sigma_b - (g_k - b_i) . n_i, 0) n_i
-//   (the LR vertex's body point and normal are reused: no HR body query).
+//   vertex in UV is a colliding i moves to g_k + max(sigma_b - (g_k - b) . n, 0) n. The
+//   paper reuses the LR vertex's plane (b, n) = (b_i, n_i) (CollisionConfig::hr_planes off);
+//   by default each such HR vertex gets its own closest point and normal (b_k, n_k), one body
+//   query over these candidates only. On a curved part of the body the LR vertex's tangent
+//   plane is not the body 15 mm away (on a 10 cm sphere, 0.3 rad from the LR vertex, it pushes
+//   a vertex lying clear of the body 4 mm further out). On the held-out salsa clips the
+//   vertex error is the same to 0.01 mm, 10% fewer HR vertices move, and the output's shear
+//   E_uv falls from 0.0128 to 0.0079 (61_03) and 0.0067 to 0.0039 (60_03).
 // Layers (garments with more than one layer only): each LR vertex e of layer L > 0 is
 //   paired with its nearest LR vertex i of the layers below (layer < L); it collides when
 //   sigma_l - (c^_e - c^_i) . n_i > 0 and |c^_e - c^_i| < gamma (n_i: area-weighted vertex
@@ -29,6 +35,7 @@ namespace gdsr {
 struct CollisionConfig {
   bool body = true;
   double sigma_b = 0.015;  // metres
+  bool hr_planes = true;   // push HR vertices out of their own tangent planes (false: the LR vertex's, the paper's)
   bool layers = true;
   double sigma_l = 0.020;  // metres
   double gamma = 0.04;     // metres
@@ -53,6 +60,7 @@ BodyQueryFn body_query_fn(const BodyQuery& body);
 struct CollisionStats {
   int lr_body = 0;   // LR vertices colliding with the body
   int hr_body = 0;   // HR vertices moved by the body pass
+  int hr_queried = 0;  // HR vertices given their own body query (hr_planes: those of colliding LR vertices)
   int lr_layer = 0;  // exterior LR vertices colliding with an interior layer
   int hr_layer = 0;  // HR vertices moved by the layer pass
   bool body_queried = false;

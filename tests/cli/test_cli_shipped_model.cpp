@@ -23,8 +23,9 @@ TEST_CASE("cli shipped model: on an unseen motion it beats the upsampled LR, sta
   REQUIRE(gdsr_run(dir, "data make --garment skirt_short --motion " + bvh + " --start 1 --seconds 1 --out '" +
                             (dir / "ds") + "'")
               .status == 0);
-  REQUIRE(gdsr_run(dir, "infer --model '" + model + "' --data '" + (dir / "ds") + "' --out '" + (dir / "pred") + "'")
-              .status == 0);
+  const gdsr_test::Run infer =
+      gdsr_run(dir, "infer --model '" + model + "' --data '" + (dir / "ds") + "' --out '" + (dir / "pred") + "'");
+  REQUIRE(infer.status == 0);
   const gdsr_test::Run eval = gdsr_run(dir, "eval --pred '" + (dir / "pred") + "' --data '" + (dir / "ds") +
                                                 "' --report '" + (dir / "report") + "' --no-video --no-export");
   REQUIRE(eval.status == 0);
@@ -40,4 +41,17 @@ TEST_CASE("cli shipped model: on an unseen motion it beats the upsampled LR, sta
     CHECK(f.at("energies").at("E_u").get<double>() < 0.04);  // the paper's range: 0.01-0.04
     CHECK(f.at("energies").at("E_uv").get<double>() < 0.065);
   }
+  // The paper's body pass (each HR vertex pushed out of its LR vertex's tangent plane) moves
+  // more HR vertices than the default, each out of its own plane.
+  const gdsr_test::Run paper = gdsr_run(dir, "infer --model '" + model + "' --data '" + (dir / "ds") +
+                                                 "' --lr-body-planes --out '" + (dir / "pred_paper") + "'");
+  REQUIRE(paper.status == 0);
+  const auto moved = [](const std::string& out) {
+    const size_t at = out.find(" HR vertices moved by collision handling");
+    REQUIRE(at != std::string::npos);
+    return std::stol(out.substr(out.rfind(", ", at) + 2));
+  };
+  MESSAGE("HR vertices moved: " << moved(infer.out) << " (own planes), " << moved(paper.out) << " (the paper's)");
+  CHECK(moved(infer.out) > 0);
+  CHECK(moved(paper.out) > moved(infer.out));
 }

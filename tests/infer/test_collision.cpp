@@ -45,9 +45,10 @@ TEST_CASE("collision: body pass pushes penetrating HR vertices to sigma_b and le
   in.body = &q;
   CollisionConfig cfg;
   const CollisionStats st = resolve_collisions(cfg, in, G);
-  CHECK(body.calls == 1);
+  CHECK(body.calls == 2);  // the LR vertices, then the HR vertices of the colliding one
   CHECK(st.body_queried);
   CHECK(st.lr_body == 1);
+  CHECK(st.hr_queried == 2);
   CHECK(st.hr_body == 1);
   CHECK(G(0, 1) == doctest::Approx(cfg.sigma_b));
   CHECK(G(0, 0) == G0(0, 0));  // moved along the normal only
@@ -77,7 +78,7 @@ TEST_CASE("collision: no body means no query / switching the body pass off too")
   CHECK(body.calls == 0);
   CHECK(G(0, 1) == -0.1);
   st = resolve_collisions({}, in, G);
-  CHECK(body.calls == 1);
+  CHECK(body.calls == 2);  // the LR vertex, then its HR vertex
   CHECK(G(0, 1) == doctest::Approx(0.015));
 }
 
@@ -170,13 +171,55 @@ TEST_CASE("collision: the Embree body adapter pushes out of a real body mesh") {
   const CollisionStats st = resolve_collisions({}, in, G);
   CHECK(st.lr_body == 1);
   CHECK(st.hr_body == 1);
-  // Moved along the LR vertex's (smooth) body normal to offset sigma_b from its body point.
-  const ClosestPoints c = q.closest(C);
+  // Moved along its own (smooth) body normal to offset sigma_b from its body point.
+  Points3 G0(1, 3);
+  G0 << 0.12, 0.49, -0.04;
+  const ClosestPoints c = q.closest(G0);
   const Vec3 n = c.normal.row(0).transpose(), b = c.point.row(0).transpose();
   const Vec3 g = G.row(0).transpose(), g0(0.12, 0.49, -0.04);
   CHECK((g - b).dot(n) == doctest::Approx(0.015));
   CHECK((g - g0).cross(n).norm() < 1e-12);
   CHECK(n.y() > 0.5);
+}
+
+TEST_CASE("collision: on a curved body each HR vertex leaves its own tangent plane, the paper's rule its LR vertex's") {
+  // Body: the sphere of radius R about the origin (closest point and normal in closed form).
+  // The LR vertex sits on top, 2 mm out: it collides. HR vertex 0 lies 1 mm beyond sigma_b off
+  // the sphere at 0.3 rad from the top (outside: stays); HR vertex 1 at the same angle 5 mm off
+  // (pushed radially to sigma_b). Both lie behind the LR vertex's plane y = R + sigma_b.
+  const double R = 0.1, sigma = 0.015, a = 0.3;
+  const BodyQueryFn sphere = [R](const Points3& q, Points3& closest, Points3& normal) {
+    normal = q.rowwise().normalized();
+    closest = R * normal;
+  };
+  Points3 C(1, 3);
+  C << 0, R + 0.002, 0;
+  Points3 G(2, 3);
+  G << (R + sigma + 0.001) * std::sin(a), (R + sigma + 0.001) * std::cos(a), 0,  //
+      (R + 0.005) * std::sin(a), (R + 0.005) * std::cos(a), 0;
+  const Points3 G0 = G;
+  const std::vector<int> nearest = {0, 0};
+  CollisionInput in;
+  in.C_hat = &C;
+  in.hr_nearest_lr = &nearest;
+  in.body = &sphere;
+  CollisionConfig cfg;
+  cfg.sigma_b = sigma;
+  CollisionStats st = resolve_collisions(cfg, in, G);
+  CHECK(st.hr_body == 1);
+  CHECK(G.row(0) == G0.row(0));
+  CHECK(G.row(1).norm() == doctest::Approx(R + sigma).epsilon(1e-12));
+  CHECK(G(1, 0) / G(1, 1) == doctest::Approx(std::tan(a)).epsilon(1e-12));  // radially
+  // The paper's rule: both move up to the LR vertex's plane, y = R + sigma.
+  G = G0;
+  cfg.hr_planes = false;
+  st = resolve_collisions(cfg, in, G);
+  CHECK(st.hr_body == 2);
+  CHECK(st.hr_queried == 0);
+  CHECK(G(0, 1) == doctest::Approx(R + sigma).epsilon(1e-12));
+  CHECK(G(0, 1) - G0(0, 1) > 0.004);  // (R + sigma) - (R + sigma + 1 mm) cos a = 4.2 mm
+  CHECK(G(1, 1) == doctest::Approx(R + sigma).epsilon(1e-12));
+  CHECK(G(0, 0) == G0(0, 0));
 }
 
 TEST_CASE("collision: the body offset is the flag, else the dataset's simulation thickness, else the paper's") {
