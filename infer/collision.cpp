@@ -42,18 +42,19 @@ Groups group_hr(const std::vector<int>& nearest, int num_lr) {
   return g;
 }
 
+// Moves row v of G along n out of the plane (p, n) to offset sigma; true when it moved.
+bool push_out_of_plane(int v, const Vec3& p, const Vec3& n, double sigma, Points3& G) {
+  const Vec3 x = G.row(v).transpose();
+  const double m = sigma - (x - p).dot(n);
+  if (!(m > 0)) return false;
+  G.row(v) = (x + m * n).transpose();
+  return true;
+}
+
 // Moves the HR vertices of LR vertex i out of the plane (p, n) to offset sigma; returns moved count.
 int push_group(const Groups& g, int i, const Vec3& p, const Vec3& n, double sigma, Points3& G) {
   int moved = 0;
-  for (int k = g.offsets[i]; k < g.offsets[i + 1]; ++k) {
-    const int v = g.items[k];
-    const Vec3 x = G.row(v).transpose();
-    const double m = sigma - (x - p).dot(n);
-    if (m > 0) {
-      G.row(v) = (x + m * n).transpose();
-      ++moved;
-    }
-  }
+  for (int k = g.offsets[i]; k < g.offsets[i + 1]; ++k) moved += push_out_of_plane(g.items[k], p, n, sigma, G);
   return moved;
 }
 
@@ -68,12 +69,7 @@ int push_own_planes(const std::vector<int>& rows, const BodyQueryFn& body, doubl
   int moved = 0;
   for (size_t k = 0; k < rows.size(); ++k) {
     const Eigen::Index r = static_cast<Eigen::Index>(k);
-    const Vec3 x = q.row(r).transpose(), nb = n.row(r).transpose();
-    const double m = sigma - (x - b.row(r).transpose()).dot(nb);
-    if (m > 0) {
-      G.row(rows[k]) = (x + m * nb).transpose();
-      ++moved;
-    }
+    moved += push_out_of_plane(rows[k], b.row(r).transpose(), n.row(r).transpose(), sigma, G);
   }
   return moved;
 }
