@@ -76,8 +76,13 @@ void write_report(const EvalArgs& a, const gdsr::Dataset& d, const gdsr::Predict
 
 void print_evaluation(const gdsr::Evaluation& e) {
   std::printf("evaluation over %zu frames (mean):\n", e.frames.size());
-  std::printf("  vertex error      GDSR %.2f mm   | LR upsampled %.2f mm\n", 1e3 * e.mean.error, 1e3 * e.mean.error_lr);
-  std::printf("  normal-map SSIM   GDSR %.4f      | LR upsampled %.4f\n", e.mean.ssim, e.mean.ssim_lr);
+  std::printf("  vertex error      GDSR %.2f mm   | LR upsampled %.2f mm | HR at the LR scale %.2f mm\n",
+              1e3 * e.mean.error, 1e3 * e.mean.error_lr, 1e3 * e.mean.error_scale);
+  std::printf("  normal-map SSIM   GDSR %.4f      | LR upsampled %.4f    | HR at the LR scale %.4f\n", e.mean.ssim,
+              e.mean.ssim_lr, e.mean.ssim_scale);
+  std::printf(
+      "    (HR at the LR scale: the HR simulation downsampled and upsampled, what a perfect correction E\n"
+      "     without detail would score)\n");
   std::printf("  stretch E_u/E_v/E_uv  GDSR %.4f / %.4f / %.4f | HR simulation %.4f / %.4f / %.4f\n",
               e.mean.energies.E_u, e.mean.energies.E_v, e.mean.energies.E_uv, e.truth.E_u, e.truth.E_v, e.truth.E_uv);
 }

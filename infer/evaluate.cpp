@@ -69,17 +69,21 @@ Evaluation evaluate(const Dataset& d, const std::vector<Points3>& G, int first_f
       gdsr::fail("evaluate", "frame " + std::to_string(t) + " has " + std::to_string(G[k].rows()) +
                                  " HR vertices, the dataset " + std::to_string(truth.rows()));
     const Points3 up = upsample(d.corr, d.lr_frames[t]);
+    const Points3 scale = upsample(d.corr, downsample(d.corr, truth));
     FrameEvaluation f;
     f.frame = t;
     f.error = (G[k] - truth).rowwise().norm().mean();
     f.error_lr = (up - truth).rowwise().norm().mean();
+    f.error_scale = (scale - truth).rowwise().norm().mean();
     if (k % ssim_every == 0) {
       const cv::Mat ref = uv_normal_map(d.raster, d.hr.F, truth);
       f.has_ssim = true;
       f.ssim = ssim(uv_normal_map(d.raster, d.hr.F, G[k]), ref);
       f.ssim_lr = ssim(uv_normal_map(d.raster, d.hr.F, up), ref);
+      f.ssim_scale = ssim(uv_normal_map(d.raster, d.hr.F, scale), ref);
       ev.mean.ssim += f.ssim;
       ev.mean.ssim_lr += f.ssim_lr;
+      ev.mean.ssim_scale += f.ssim_scale;
       ++n_ssim;
     }
     f.energies = strain_energies(d.hr, G[k]);
@@ -87,6 +91,7 @@ Evaluation evaluate(const Dataset& d, const std::vector<Points3>& G, int first_f
     f.energies_hr = strain_energies(d.hr, truth);
     ev.mean.error += f.error / count;
     ev.mean.error_lr += f.error_lr / count;
+    ev.mean.error_scale += f.error_scale / count;
     add_scaled(ev.mean.energies, f.energies, 1.0 / count);
     add_scaled(ev.mean.energies_lr, f.energies_lr, 1.0 / count);
     add_scaled(ev.mean.energies_hr, f.energies_hr, 1.0 / count);
@@ -96,6 +101,7 @@ Evaluation evaluate(const Dataset& d, const std::vector<Points3>& G, int first_f
   if (n_ssim > 0) {
     ev.mean.ssim /= n_ssim;
     ev.mean.ssim_lr /= n_ssim;
+    ev.mean.ssim_scale /= n_ssim;
   }
   ev.mean.frame = -1;
   ev.truth = ev.mean.energies_hr;

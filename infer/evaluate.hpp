@@ -1,5 +1,8 @@
 // Evaluation of predicted HR sequences against the HR simulation (paper 5, appendices B-C):
 // vertex error, SSIM of UV normal maps, and the stretch / shear energies of appendix B.
+// Two references beside the prediction: the LR simulation upsampled (the baseline GDSR must
+// beat) and the HR simulation at the LR scale, downsampled and upsampled again (what a
+// perfect correction E with no detail A would score: the part of the error E can remove).
 #pragma once
 
 #include "gdsr/io/progress.hpp"
@@ -28,6 +31,8 @@ struct FrameEvaluation {
   bool has_ssim = false;       // SSIM computed on this frame (every ssim_every-th)
   double ssim = 0;             // normal maps of G vs G*
   double ssim_lr = 0;          // normal maps of the upsampled LR vs G*
+  double error_scale = 0;      // mean |S - G*|, S = upsample(downsample(G*)) (perfect E, no A)
+  double ssim_scale = 0;       // normal maps of S vs G*
   StrainEnergies energies;     // of G
   StrainEnergies energies_lr;  // of the upsampled LR (baseline)
   StrainEnergies energies_hr;  // of the ground truth G*

@@ -21,10 +21,11 @@ nlohmann::json frame_json(const FrameEvaluation& f) {
   nlohmann::json j{{"frame", f.frame},
                    {"error_m", f.error},
                    {"error_lr_m", f.error_lr},
+                   {"error_hr_lr_scale_m", f.error_scale},
                    {"energies", energies_json(f.energies)},
                    {"energies_lr", energies_json(f.energies_lr)},
                    {"energies_hr", energies_json(f.energies_hr)}};
-  if (f.has_ssim) j["ssim"] = f.ssim, j["ssim_lr"] = f.ssim_lr;
+  if (f.has_ssim) j["ssim"] = f.ssim, j["ssim_lr"] = f.ssim_lr, j["ssim_hr_lr_scale"] = f.ssim_scale;
   return j;
 }
 
@@ -87,6 +88,7 @@ std::vector<std::string> write_eval_report(const std::string& dir, const Dataset
                    {"dataset_stats", d.manifest.stats}};
   j["mean"]["ssim"] = e.mean.ssim;
   j["mean"]["ssim_lr"] = e.mean.ssim_lr;
+  j["mean"]["ssim_hr_lr_scale"] = e.mean.ssim_scale;
   for (const auto& f : e.frames) j["per_frame"].push_back(frame_json(f));
   write_file_atomic((fs::path(dir) / "report.json").string(), j.dump(1));
   files.push_back("report.json");

@@ -48,7 +48,10 @@ TEST_CASE("report: tables plots images and video of a short roll-out") {
                         "images/normals_00007.png", "plots/energies.png", "rollout.avi", "0.012 + -"})
     CHECK_MESSAGE(md.find(s) != std::string::npos, s);
   char row[128];
-  std::snprintf(row, sizeof row, "| wave | %.4f | %.4f |", e.mean.ssim_lr, e.mean.ssim);
+  std::snprintf(row, sizeof row, "| wave | %.4f | %.4f | %.4f |", e.mean.ssim_lr, e.mean.ssim, e.mean.ssim_scale);
+  CHECK(md.find(row) != std::string::npos);
+  std::snprintf(row, sizeof row, "| HR at the LR scale | %.2f | %.2f | %.2f |", 1e3 * e.frames[0].error_scale,
+                1e3 * e.frames[6].error_scale, 1e3 * e.mean.error_scale);
   CHECK(md.find(row) != std::string::npos);
   std::snprintf(row, sizeof row, "| GDSR | %.2f | %.2f | %.2f |", 1e3 * e.frames[0].error, 1e3 * e.frames[6].error,
                 1e3 * e.mean.error);
@@ -70,6 +73,8 @@ TEST_CASE("report: tables plots images and video of a short roll-out") {
   std::ifstream(dir / "r/report.json") >> j;
   CHECK(j["per_frame"].size() == 7);
   CHECK(j["per_frame"][2]["ssim"].get<double>() == doctest::Approx(e.frames[2].ssim));
+  CHECK(j["per_frame"][2]["ssim_hr_lr_scale"].get<double>() == doctest::Approx(e.frames[2].ssim_scale));
+  CHECK(j["mean"]["error_hr_lr_scale_m"].get<double>() == doctest::Approx(e.mean.error_scale));
   CHECK_FALSE(j["per_frame"][1].contains("ssim"));  // ssim_every 2
 
   cv::VideoCapture video(dir / "r/rollout.avi");
