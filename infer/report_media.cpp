@@ -18,6 +18,7 @@ namespace gdsr {
 namespace {
 
 const cv::Scalar kGdsr(200, 90, 30), kLr(40, 140, 240), kHr(60, 150, 60);  // BGR: blue, orange, green
+const cv::Scalar kScale(150, 150, 150);  // grey: the HR simulation at the LR scale (a perfect correction E)
 
 std::vector<double> column(const Evaluation& e, double (*get)(const FrameEvaluation&)) {
   std::vector<double> v;
@@ -73,21 +74,25 @@ cv::Mat plot_error(const Evaluation& e) {
   o.y_label = "mm";
   o.y_from_zero = true;
   const auto x = frames_of(e);
-  return line_plot({{"Upsampled LR", x, column(e, [](const FrameEvaluation& f) { return 1e3 * f.error_lr; }), kLr},
-                    {"GDSR", x, column(e, [](const FrameEvaluation& f) { return 1e3 * f.error; }), kGdsr}},
-                   o);
+  return line_plot(
+      {{"Upsampled LR", x, column(e, [](const FrameEvaluation& f) { return 1e3 * f.error_lr; }), kLr},
+       {"GDSR", x, column(e, [](const FrameEvaluation& f) { return 1e3 * f.error; }), kGdsr},
+       {"HR at the LR scale", x, column(e, [](const FrameEvaluation& f) { return 1e3 * f.error_scale; }), kScale}},
+      o);
 }
 
 cv::Mat plot_ssim(const Evaluation& e) {
-  std::vector<double> x, s, s_lr;
+  std::vector<double> x, s, s_lr, s_scale;
   for (const auto& f : e.frames)
-    if (f.has_ssim) x.push_back(f.frame), s.push_back(f.ssim), s_lr.push_back(f.ssim_lr);
+    if (f.has_ssim)
+      x.push_back(f.frame), s.push_back(f.ssim), s_lr.push_back(f.ssim_lr), s_scale.push_back(f.ssim_scale);
   if (x.empty()) gdsr::fail("plot_ssim", "no frame has an SSIM");
   PlotOptions o;
-  o.title = "Normal-map SSIM against the HR simulation";
+  o.title = "Normal-map SSIM to the HR simulation";
   o.x_label = "dataset frame";
   o.y_label = "SSIM";
-  return line_plot({{"Upsampled LR", x, s_lr, kLr}, {"GDSR", x, s, kGdsr}}, o);
+  return line_plot({{"Upsampled LR", x, s_lr, kLr}, {"GDSR", x, s, kGdsr}, {"HR at the LR scale", x, s_scale, kScale}},
+                   o);
 }
 
 cv::Mat plot_energies(const Evaluation& e) {

@@ -13,7 +13,8 @@
 namespace gdsr {
 
 // Vertex error (mm), SSIM and the three energies per dataset frame, GDSR against the
-// upsampled LR (and, for the energies, the HR simulation).
+// upsampled LR (error and SSIM: and the HR simulation at the LR scale; energies: and the HR
+// simulation).
 cv::Mat plot_error(const Evaluation& e);
 cv::Mat plot_ssim(const Evaluation& e);  // frames with SSIM only; throws if there are none
 cv::Mat plot_energies(const Evaluation& e);

@@ -4,6 +4,7 @@
 
 #include "gdsr/error.hpp"
 #include "infer/report.hpp"
+#include "infer/report_media.hpp"
 #include "infer/report_tables.hpp"
 #include "tests/support/data_fixtures.hpp"
 
@@ -87,4 +88,13 @@ TEST_CASE("report: tables plots images and video of a short roll-out") {
   opt.image_steps = {8};
   CHECK_THROWS_WITH_AS(gdsr::write_eval_report(dir / "r2", d, p, e, opt), doctest::Contains("image step 8"),
                        gdsr::Error);
+}
+
+TEST_CASE("report: the error and SSIM plots draw the HR at the LR scale") {
+  const gdsr::Dataset d = gdsr_test::wave_dataset(5);
+  const gdsr::Evaluation e = gdsr::evaluate(d, {d.hr_frames[1], d.hr_frames[2], d.hr_frames[3]}, 1);
+  gdsr::Evaluation moved = e;  // the same evaluation with that series alone changed
+  for (auto& f : moved.frames) f.error_scale *= 0.5, f.ssim_scale = 0.5 * (f.ssim_scale + f.ssim_lr);
+  CHECK(cv::norm(gdsr::plot_error(e), gdsr::plot_error(moved), cv::NORM_L1) > 0);
+  CHECK(cv::norm(gdsr::plot_ssim(e), gdsr::plot_ssim(moved), cv::NORM_L1) > 0);
 }
