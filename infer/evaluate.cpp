@@ -69,7 +69,7 @@ Evaluation evaluate(const Dataset& d, const std::vector<Points3>& G, int first_f
       gdsr::fail("evaluate", "frame " + std::to_string(t) + " has " + std::to_string(G[k].rows()) +
                                  " HR vertices, the dataset " + std::to_string(truth.rows()));
     const Points3 up = upsample(d.corr, d.lr_frames[t]);
-    const Points3 scale = upsample(d.corr, downsample(d.corr, truth));
+    const Points3 scale = at_lr_scale(d.corr, truth);
     FrameEvaluation f;
     f.frame = t;
     f.error = (G[k] - truth).rowwise().norm().mean();

@@ -31,7 +31,7 @@ struct FrameEvaluation {
   bool has_ssim = false;       // SSIM computed on this frame (every ssim_every-th)
   double ssim = 0;             // normal maps of G vs G*
   double ssim_lr = 0;          // normal maps of the upsampled LR vs G*
-  double error_scale = 0;      // mean |S - G*|, S = upsample(downsample(G*)) (perfect E, no A)
+  double error_scale = 0;      // mean |S - G*|, S = at_lr_scale(G*) (perfect E, no A)
   double ssim_scale = 0;       // normal maps of S vs G*
   StrainEnergies energies;     // of G
   StrainEnergies energies_lr;  // of the upsampled LR (baseline)

@@ -188,7 +188,7 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
     const Points3 up = upsample(d.corr, d.lr_frames[t]);
     v.upsampled_mean_curvature += wrinkle_measure(up, d.hr.F).mean_curvature / T;
     const double agree = mean_distance(d.hr_frames[t], up);
-    const Points3 hr_coarse = upsample(d.corr, downsample(d.corr, d.hr_frames[t]));
+    const Points3 hr_coarse = at_lr_scale(d.corr, d.hr_frames[t]);
     v.agreement_lr_scale += mean_distance(hr_coarse, up) / T;
     v.agreement_finer += mean_distance(d.hr_frames[t], hr_coarse) / T;
     v.per_frame[t].agreement = agree;

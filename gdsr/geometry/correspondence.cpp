@@ -128,6 +128,10 @@ Points3 downsample(const Correspondence& c, const Points3& hr_positions) {
   return sum;
 }
 
+Points3 at_lr_scale(const Correspondence& c, const Points3& hr_positions) {
+  return upsample(c, downsample(c, hr_positions));
+}
+
 void validate_correspondence(const Correspondence& c) {
   auto check_map = [](const BaryMap& m, long expect, long faces, const char* name) {
     if (m.size() != expect || m.bary.rows() != expect)

@@ -43,6 +43,9 @@ Points3 apply_bary(const BaryMap& map, const Faces& faces, const Points3& positi
 Points3 upsample(const Correspondence& c, const Points3& lr_positions);
 // HR positions (hr_vertices x 3) -> LR positions (lr_vertices x 3), seam copies averaged.
 Points3 downsample(const Correspondence& c, const Points3& hr_positions);
+// S = upsample(downsample(hr)), hr_vertices x 3: an HR shape at the LR scale, what the LR mesh can
+// hold of it (a perfect coarse correction reaches S; HR - S are the wrinkles left to the detail).
+Points3 at_lr_scale(const Correspondence& c, const Points3& hr_positions);
 
 // The first (lowest-index) UV copy of each welded vertex; throws if a vertex has none.
 std::vector<int> first_uv_copy(const std::vector<int>& uv_to_vertex, int num_vertices);

@@ -94,6 +94,10 @@ TEST_CASE("correspondence: a finer unrelated grid reproduces affine fields") {
   };
   CHECK(max_abs(upsample(c, affine(lr)), affine(hr)) < 1e-12);
   CHECK(max_abs(downsample(c, affine(hr)), affine(lr)) < 1e-12);
+  CHECK(max_abs(at_lr_scale(c, affine(hr)), affine(hr)) < 1e-12);  // the LR mesh holds an affine shape
+  Points3 ripple = affine(hr);  // plus the finest ripple the HR grid holds (+-1 cm from column to column): not held
+  for (int i = 0; i < ripple.rows(); ++i) ripple(i, 2) += 0.01 * std::cos(M_PI * hr.V(i, 0) / (0.7 / 20));
+  CHECK(max_abs(at_lr_scale(c, ripple), ripple) > 1e-3);
   for (int i = 0; i < hr.V.rows(); ++i) {
     const Eigen::Vector2d p = hr.UV.row(i);
     double best = std::numeric_limits<double>::infinity();
