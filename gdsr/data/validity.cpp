@@ -4,6 +4,7 @@
 
 #include "gdsr/body/body_query.hpp"
 #include "gdsr/geometry/correspondence.hpp"
+#include "gdsr/geometry/mesh_ops.hpp"
 #include "gdsr/geometry/self_intersections.hpp"
 #include "gdsr/geometry/wrinkles.hpp"
 
@@ -109,6 +110,46 @@ bool body_crosses_itself(const Points3& V, const Faces& F, const Points3& rest, 
   return false;
 }
 
+// Edges of X (rows of `edges`) with both ends outside the body whose segment runs through it:
+// the middle of its span between the first and the last crossing lies deeper than `depth`
+// metres (validity.hpp; a chord grazing a curved surface dips in by a fraction of that).
+long threaded_edges(const BodyQuery& body, const Points3& X, const Pairs& edges, double depth) {
+  const ClosestPoints cp = body.closest(X, /*smooth_normals=*/false);
+  std::vector<int> out;  // edges with both ends outside
+  for (int e = 0; e < edges.rows(); ++e) {
+    const int i = edges(e, 0), j = edges(e, 1);
+    if (cp.sdist(i) > 0 && cp.sdist(j) > 0 && (X.row(j) - X.row(i)).squaredNorm() > 1e-24) out.push_back(e);
+  }
+  const int n = static_cast<int>(out.size());
+  Points3 from(n, 3), to(n, 3);
+  for (int k = 0; k < n; ++k) {
+    from.row(k) = X.row(edges(out[k], 0));
+    to.row(k) = X.row(edges(out[k], 1));
+  }
+  const Points3 dir = to - from;
+  const RayHits enter = body.intersect(from, dir, 0.0, 1.0), leave = body.intersect(to, -dir, 0.0, 1.0);
+  std::vector<int> crossing;
+  for (int k = 0; k < n; ++k)
+    if (enter.face(k) >= 0 && leave.face(k) >= 0) crossing.push_back(k);
+  Points3 mid(crossing.size(), 3);
+  for (size_t c = 0; c < crossing.size(); ++c) {
+    const int k = crossing[c];
+    mid.row(static_cast<Eigen::Index>(c)) = from.row(k) + 0.5 * (enter.t(k) + 1 - leave.t(k)) * dir.row(k);
+  }
+  const ClosestPoints inside = body.closest(mid, /*smooth_normals=*/false);
+  long threaded = 0;
+  for (Eigen::Index c = 0; c < mid.rows(); ++c) threaded += inside.sdist(c) < -depth;
+  return threaded;
+}
+
+void add_threaded(long edges, int t, ResolutionValidity& r) {
+  r.threaded_frames += edges > 0;
+  if (edges > r.max_threaded_edges) {
+    r.max_threaded_edges = edges;
+    r.max_threaded_frame = t;
+  }
+}
+
 void add_penetration(const Depths& d, int t, double limit, bool body_crossing, ResolutionValidity& r) {
   if (d.all > r.max_penetration) {  // the frame stays -1 while nothing penetrates
     r.max_penetration = d.all;
@@ -151,6 +192,7 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
   if (!(opt.penetration_limit >= 0)) fail("validity", "penetration limit must be >= 0");
   if (!(opt.pinch_reach > 0) || !(opt.pinch_separation > 0)) fail("validity", "pinch reach and separation must be > 0");
   if (!(opt.tear_stretch > 1)) fail("validity", "tear stretch must be > 1");
+  if (!(opt.threaded_depth > 0)) fail("validity", "threaded depth must be > 0");
   const int T = static_cast<int>(d.lr_frames.size());
   if (T == 0 || d.hr_frames.size() != d.lr_frames.size())
     fail("validity", "the dataset has no frames (or LR/HR counts differ)");
@@ -159,6 +201,7 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
   v.intersection_stride = opt.intersection_stride;
   v.penetration_limit = opt.penetration_limit;
   v.tear_stretch = opt.tear_stretch;
+  v.threaded_depth = opt.threaded_depth;
   v.lr.faces = static_cast<int>(d.lr.F.rows());
   v.hr.faces = static_cast<int>(d.hr.F.rows());
   v.body_measured = opt.body && d.has_body();
@@ -167,6 +210,7 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
 
   const int steps = T + 2;  // the per-frame figures, then the LR and the HR self-intersections
   std::unique_ptr<BodyQuery> body;
+  const Pairs lr_edges = unique_edges(d.lr.F), hr_edges = unique_edges(d.hr.F);
   for (int t = 0; t < T; ++t) {
     auto strain = [&](const GarmentMesh& g, const Points3& X, ResolutionValidity& r) {
       const StrainEnergies e = strain_energies(g, X);
@@ -212,6 +256,8 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
       add_penetration(hr, t, opt.penetration_limit, crossing, v.hr);
       v.per_frame[t].lr_depth = lr.free;
       v.per_frame[t].hr_depth = hr.free;
+      add_threaded(threaded_edges(*body, d.lr_frames[t], lr_edges, opt.threaded_depth), t, v.lr);
+      add_threaded(threaded_edges(*body, d.hr_frames[t], hr_edges, opt.threaded_depth), t, v.hr);
     }
     if (progress) progress(t + 1, steps);
   }
@@ -255,7 +301,10 @@ nlohmann::json resolution_json(const ResolutionValidity& r, bool body) {
                  {"max_penetration_outside_pinches_frame", r.max_penetration_free_frame},
                  {"frames_over_limit_outside_pinches", r.frames_over_limit_free},
                  {"pinch_frames", r.pinch_frames},
-                 {"pinch_frames_in_body_crossings", r.pinch_frames_in_body_crossings}};
+                 {"pinch_frames_in_body_crossings", r.pinch_frames_in_body_crossings},
+                 {"threaded_frames", r.threaded_frames},
+                 {"max_threaded_edges", r.max_threaded_edges},
+                 {"max_threaded_frame", r.max_threaded_frame}};
   return j;
 }
 
@@ -314,6 +363,14 @@ ResolutionValidity resolution_from_json(const nlohmann::json& j, bool body, cons
     // ... and before the body's own crossings were counted: unknown.
     r.pinch_frames_in_body_crossings =
         b.contains("pinch_frames_in_body_crossings") ? take<int>(b, "pinch_frames_in_body_crossings", where + "body.") : -1;
+    // ... and before threaded cloth was counted: not measured.
+    if (b.contains("threaded_frames")) {
+      r.threaded_frames = take<int>(b, "threaded_frames", where + "body.");
+      r.max_threaded_edges = take<long>(b, "max_threaded_edges", where + "body.");
+      r.max_threaded_frame = take<int>(b, "max_threaded_frame", where + "body.");
+    } else {
+      r.threaded_frames = -1;
+    }
   }
   return r;
 }
@@ -325,6 +382,7 @@ nlohmann::json validity_to_json(const ValidityFigures& v) {
                       {"intersection_stride", v.intersection_stride},
                       {"penetration_limit_m", v.penetration_limit},
                       {"tear_stretch", v.tear_stretch},
+                      {"threaded_depth_m", v.threaded_depth},
                       {"body_measured", v.body_measured},
                       {"lr", resolution_json(v.lr, v.body_measured)},
                       {"hr", resolution_json(v.hr, v.body_measured)},
@@ -346,6 +404,7 @@ ValidityFigures validity_from_json(const nlohmann::json& j) {
   v.intersection_stride = take<int>(j, "intersection_stride", "");
   v.penetration_limit = take<double>(j, "penetration_limit_m", "");
   if (j.contains("tear_stretch")) v.tear_stretch = take<double>(j, "tear_stretch", "");
+  if (j.contains("threaded_depth_m")) v.threaded_depth = take<double>(j, "threaded_depth_m", "");
   v.body_measured = take<bool>(j, "body_measured", "");
   v.body_crossing_frames = j.contains("body_crossing_frames") ? take<int>(j, "body_crossing_frames", "") : -1;
   v.lr = resolution_from_json(take<nlohmann::json>(j, "lr", ""), v.body_measured, "lr.");
@@ -438,6 +497,16 @@ std::string validity_table(const ValidityFigures& v) {
       line("  %-40s %14d\n", "body: frames it crosses itself (2 parts)", v.body_crossing_frames);
       line("  %-40s %14d %14d\n", "  pinch frames among them", v.lr.pinch_frames_in_body_crossings,
            v.hr.pinch_frames_in_body_crossings);
+    }
+    if (v.lr.threaded_frames >= 0 && v.hr.threaded_frames >= 0) {
+      auto most = [](const ResolutionValidity& r) {
+        char b[48];
+        if (r.max_threaded_frame < 0) return std::string("none");
+        std::snprintf(b, sizeof b, "%ld (f%3d)", r.max_threaded_edges, r.max_threaded_frame);
+        return std::string(b);
+      };
+      line("  %-40s %14d %14d\n", "body: frames with cloth threaded on it", v.lr.threaded_frames, v.hr.threaded_frames);
+      line("  %-40s %14s %14s\n", "  most edges through the body (frame)", most(v.lr).c_str(), most(v.hr).c_str());
     }
   } else {
     line("  %-40s %14s %14s\n", "body: penetration", "not measured", "(no body)");

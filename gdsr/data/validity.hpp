@@ -15,7 +15,11 @@
 //     and the body's own crossings: frames where two body faces intersect (CGAL) whose
 //     vertices were all farther than pinch_separation apart in the first frame (two parts:
 //     a mocap forearm passing into the trunk; the skin creasing at a bent joint does not
-//     count), and the pinch frames among them (the motion leaves the cloth no room);
+//     count), and the pinch frames among them (the motion leaves the cloth no room); and cloth
+//     threaded on the body: frames with an edge whose two ends are outside the body while the
+//     segment between them runs through it (Embree rays from both ends; the middle of its span
+//     between the first and the last crossing deeper than threaded_depth): a hand or forearm
+//     that passed between two cloth vertices and carries the cloth over itself;
 //   - agreement: distance of each HR vertex to the LR frame upsampled to HR topology through
 //     the dataset's correspondence (gdsr/geometry/correspondence.hpp), and split by scale with
 //     HR's own shape at the LR scale, S = upsample(downsample(HR)): |S - upsample(LR)| is a
@@ -45,6 +49,8 @@ struct ValidityOptions {
   double pinch_reach = 0.04;         // metres: a second body part this close to a penetrating vertex pinches it
   double pinch_separation = 0.15;    // metres apart in the first frame: two points on different body parts
   double tear_stretch = 2;           // frames with an edge longer than this times its pattern length are counted
+  double threaded_depth = 0.005;     // metres: an edge with both ends outside the body and its middle inside deeper
+                                     // than this is threaded (a chord of cloth resting on a wrist dips ~2 mm)
 };
 
 // Figures of one resolution (LR or HR) over the clip.
@@ -74,6 +80,9 @@ struct ResolutionValidity {
   int frames_over_limit_free = 0;
   int pinch_frames = 0;  // frames where a pinched vertex is deeper than the limit
   int pinch_frames_in_body_crossings = 0;  // of those, frames where the body crosses itself (-1: not measured)
+  int threaded_frames = 0;                 // frames with cloth threaded on the body (see above; -1: not measured)
+  long max_threaded_edges = 0;             // the most threaded edges in a frame
+  int max_threaded_frame = -1;             // its frame (-1: none in any frame)
   double mean_curvature = 0;       // 1/m, mean over frames
 };
 
@@ -89,6 +98,7 @@ struct ValidityFigures {
   int intersection_stride = 1;
   double penetration_limit = 0.005;  // metres
   double tear_stretch = 2;           // see ValidityOptions
+  double threaded_depth = 0.005;     // metres, see ValidityOptions
   bool body_measured = false;
   int body_crossing_frames = 0;  // frames where two body parts intersect (see above; -1: not measured)
   ResolutionValidity lr, hr;

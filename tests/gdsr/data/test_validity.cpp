@@ -1,8 +1,9 @@
 // Validity figures of synthetic datasets whose answers are known in closed form: a sheet
 // stretched 10% along u (E_u = 0.01), HR lifted 2 mm off the LR (agreement 2 mm), a box body
-// rising through the sheet (known depths), and an HR frame wrapped 1.25 times round a cylinder
-// (self-overlap).
+// rising through the sheet (known depths), an HR frame wrapped 1.25 times round a cylinder
+// (self-overlap), and a thin box passing through the sheet between two vertices (threaded).
 #include "gdsr/data/validity.hpp"
+#include "gdsr/body/body_query.hpp"
 #include "gdsr/error.hpp"
 #include "gdsr/geometry/correspondence.hpp"
 #include "gdsr/geometry/wrinkles.hpp"
@@ -336,4 +337,64 @@ TEST_CASE("gdsr: validity counts the frames where a vertex is dragged out of the
   const gdsr::ValidityFigures o = gdsr::validity_from_json(old);
   CHECK(o.hr.torn_frames == -1);
   CHECK(gdsr::validity_table(o).find("frames with an edge") == std::string::npos);
+}
+
+TEST_CASE("gdsr: validity counts the frames where cloth is threaded on a body part") {
+  // The body box of the tests above stays 1 cm under the sheet. In frame 1 a "forearm" box
+  // x in [0.05, 0.075], y in [0.065, 0.085], z in [-0.02, 0.02] passes through the sheet between
+  // two vertices of the row y = 0.075 (LR x = 0, 0.0825; HR x = 0.04125, 0.0825): the edge
+  // between them has both ends outside and its middle 1 cm deep inside (the box's half-width
+  // in y). In the other frames the forearm is 0.5 m away.
+  gdsr::Dataset d = stretched_dataset({-0.01, -0.01, -0.01});
+  auto with_forearm = [&](double x0, double x1) {
+    gdsr::Dataset e = d;
+    const gdsr::TriMesh near = box(x0, x1, 0.065, 0.085, -0.02, 0.02), far = box(0.6, 0.65, 0.065, 0.085, -0.02, 0.02);
+    gdsr::Faces F(24, 3);
+    F << d.body_faces, (far.F.array() + 8).matrix();
+    e.body_faces = F;
+    for (size_t t = 0; t < e.body_frames.size(); ++t) {
+      Points3 V(16, 3);
+      V << d.body_frames[t], (t == 1 ? near : far).V;
+      e.body_frames[t] = V;
+    }
+    return e;
+  };
+  const gdsr::Dataset threaded = with_forearm(0.05, 0.075);
+  for (const auto& X : {threaded.lr_frames[1], threaded.hr_frames[1]}) {  // no vertex inside the forearm
+    const gdsr::BodyQuery q(gdsr::TriMesh{threaded.body_frames[1], threaded.body_faces});
+    REQUIRE(q.closest(X).sdist.minCoeff() > 0);
+  }
+  gdsr::ValidityOptions opt;
+  const gdsr::ValidityFigures v = gdsr::measure_validity(threaded, opt);
+  for (const auto* r : {&v.lr, &v.hr}) {
+    CHECK(r->threaded_frames == 1);
+    CHECK(r->max_threaded_frame == 1);
+    CHECK(r->max_threaded_edges >= 1);
+    CHECK(r->max_penetration_frame == -1);  // no vertex is inside: only the edges show it
+    CHECK(r->torn_frames == 0);
+  }
+  // A deeper threshold than the 1 cm, or a part 6 mm thick (its middle 3 mm deep, as a chord
+  // grazing a curved body dips in), counts none.
+  opt.threaded_depth = 0.011;
+  CHECK(gdsr::measure_validity(threaded, opt).lr.threaded_frames == 0);
+  opt.threaded_depth = 0.005;
+  const gdsr::ValidityFigures thin = gdsr::measure_validity(with_forearm(0.06, 0.066), opt);
+  CHECK(thin.lr.threaded_frames == 0);
+  CHECK(thin.hr.threaded_frames == 0);
+  opt.threaded_depth = 0;
+  CHECK_THROWS_WITH_AS(gdsr::measure_validity(threaded, opt), doctest::Contains("threaded depth"), gdsr::Error);
+  // Printed, survives the manifest; manifests written before the figure read -1 and print none.
+  const std::string table = gdsr::validity_table(v);
+  CHECK(table.find("body: frames with cloth threaded on it") != std::string::npos);
+  const nlohmann::json j = gdsr::validity_to_json(v);
+  const gdsr::ValidityFigures back = gdsr::validity_from_json(j);
+  CHECK(back.hr.threaded_frames == 1);
+  CHECK(back.hr.max_threaded_edges == v.hr.max_threaded_edges);
+  CHECK(back.threaded_depth == 0.005);
+  nlohmann::json old = j;
+  for (const char* res : {"lr", "hr"})
+    for (const char* k : {"threaded_frames", "max_threaded_edges", "max_threaded_frame"}) old[res]["body"].erase(k);
+  const gdsr::ValidityFigures o = gdsr::validity_from_json(old);
+  CHECK(o.lr.threaded_frames == -1);
+  CHECK(gdsr::validity_table(o).find("threaded") == std::string::npos);
 }
