@@ -121,6 +121,7 @@ long threaded_edges(const BodyQuery& body, const Points3& X, const Pairs& edges,
     if (cp.sdist(i) > 0 && cp.sdist(j) > 0 && (X.row(j) - X.row(i)).squaredNorm() > 1e-24) out.push_back(e);
   }
   const int n = static_cast<int>(out.size());
+  if (n == 0) return 0;
   Points3 from(n, 3), to(n, 3);
   for (int k = 0; k < n; ++k) {
     from.row(k) = X.row(edges(out[k], 0));
@@ -131,6 +132,7 @@ long threaded_edges(const BodyQuery& body, const Points3& X, const Pairs& edges,
   std::vector<int> crossing;
   for (int k = 0; k < n; ++k)
     if (enter.face(k) >= 0 && leave.face(k) >= 0) crossing.push_back(k);
+  if (crossing.empty()) return 0;
   Points3 mid(crossing.size(), 3);
   for (size_t c = 0; c < crossing.size(); ++c) {
     const int k = crossing[c];
