@@ -174,12 +174,14 @@ double mean_distance(const Points3& a, const Points3& b) {
 }  // namespace
 
 std::string validity_per_frame_csv(const ValidityFigures& v) {
-  std::string s = "frame,lr_pairs,hr_pairs,lr_depth_outside_pinches_mm,hr_depth_outside_pinches_mm,agreement_mm\n";
+  std::string s =
+      "frame,lr_pairs,hr_pairs,lr_depth_outside_pinches_mm,hr_depth_outside_pinches_mm,agreement_mm,lr_threaded,"
+      "hr_threaded\n";
   char buf[160];
   for (size_t t = 0; t < v.per_frame.size(); ++t) {
     const FrameValidity& f = v.per_frame[t];
-    std::snprintf(buf, sizeof buf, "%zu,%ld,%ld,%.2f,%.2f,%.2f\n", t, f.lr_pairs, f.hr_pairs, 1e3 * f.lr_depth,
-                  1e3 * f.hr_depth, 1e3 * f.agreement);
+    std::snprintf(buf, sizeof buf, "%zu,%ld,%ld,%.2f,%.2f,%.2f,%ld,%ld\n", t, f.lr_pairs, f.hr_pairs, 1e3 * f.lr_depth,
+                  1e3 * f.hr_depth, 1e3 * f.agreement, f.lr_threaded, f.hr_threaded);
     s += buf;
   }
   return s;
@@ -258,8 +260,10 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
       add_penetration(hr, t, opt.penetration_limit, crossing, v.hr);
       v.per_frame[t].lr_depth = lr.free;
       v.per_frame[t].hr_depth = hr.free;
-      add_threaded(threaded_edges(*body, d.lr_frames[t], lr_edges, opt.threaded_depth), t, v.lr);
-      add_threaded(threaded_edges(*body, d.hr_frames[t], hr_edges, opt.threaded_depth), t, v.hr);
+      v.per_frame[t].lr_threaded = threaded_edges(*body, d.lr_frames[t], lr_edges, opt.threaded_depth);
+      v.per_frame[t].hr_threaded = threaded_edges(*body, d.hr_frames[t], hr_edges, opt.threaded_depth);
+      add_threaded(v.per_frame[t].lr_threaded, t, v.lr);
+      add_threaded(v.per_frame[t].hr_threaded, t, v.hr);
     }
     if (progress) progress(t + 1, steps);
   }

@@ -91,6 +91,7 @@ struct FrameValidity {
   long lr_pairs = -1, hr_pairs = -1;  // intersecting triangle pairs (-1: frame not checked, see the stride)
   double lr_depth = 0, hr_depth = 0;  // metres, deepest vertex under the body surface outside pinches (0: none)
   double agreement = 0;               // metres, mean |HR - upsampled LR|
+  long lr_threaded = 0, hr_threaded = 0;  // edges of cloth threaded on the body (0 without a body)
 };
 
 struct ValidityFigures {
@@ -124,7 +125,7 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt = 
 
 // The per-frame figures as CSV text: a header, then one line per frame (frame, LR and HR
 // intersecting pairs with -1 for unchecked frames, LR and HR depth outside pinches in mm,
-// agreement in mm).
+// agreement in mm, LR and HR threaded edges).
 std::string validity_per_frame_csv(const ValidityFigures& v);
 
 // The manifest's "validity" object (docs/dataset-format.md) and back; from_json throws

@@ -113,7 +113,7 @@ TEST_CASE("gdsr: validity figures of a stretched, lifted sheet over a rising box
   }
   const std::string csv = gdsr::validity_per_frame_csv(v);
   CHECK(std::count(csv.begin(), csv.end(), '\n') == 5);
-  CHECK(csv.find("\n2,0,0,8.00,6.00,2.00\n") != std::string::npos);
+  CHECK(csv.find("\n2,0,0,8.00,6.00,2.00,0,0\n") != std::string::npos);
 
   // Without the body: no penetration figures, and the table says so.
   opt.body = false;
@@ -373,6 +373,19 @@ TEST_CASE("gdsr: validity counts the frames where cloth is threaded on a body pa
     CHECK(r->max_penetration_frame == -1);  // no vertex is inside: only the edges show it
     CHECK(r->torn_frames == 0);
   }
+  // Per frame: only frame 1 has threaded edges, and the CSV carries them.
+  REQUIRE(v.per_frame.size() == 3);
+  CHECK(v.per_frame[1].lr_threaded == v.lr.max_threaded_edges);
+  CHECK(v.per_frame[1].hr_threaded == v.hr.max_threaded_edges);
+  CHECK(v.per_frame[0].lr_threaded + v.per_frame[2].lr_threaded + v.per_frame[0].hr_threaded +
+            v.per_frame[2].hr_threaded ==
+        0);
+  const std::string csv = gdsr::validity_per_frame_csv(v);
+  CHECK(csv.find(",lr_threaded,hr_threaded\n") != std::string::npos);
+  CHECK(csv.find("\n1,") != std::string::npos);
+  const size_t row1 = csv.find("\n1,") + 1;
+  const std::string line1 = csv.substr(row1, csv.find('\n', row1) - row1);
+  CHECK(line1.substr(line1.rfind(',') + 1) == std::to_string(v.hr.max_threaded_edges));
   // A deeper threshold than the 1 cm, or a part 6 mm thick (its middle 3 mm deep, as a chord
   // grazing a curved body dips in), counts none.
   opt.threaded_depth = 0.011;
