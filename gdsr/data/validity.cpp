@@ -70,9 +70,10 @@ struct Depths {
 };
 
 // Deepest garment vertex under the body surface, overall and split by pinch (validity.hpp).
-// body_rest: the body in the first frame, where body parts are told apart.
-Depths penetration(const BodyQuery& body, const Points3& body_rest, const Points3& X, const ValidityOptions& opt) {
-  const ClosestPoints cp = body.closest(X, /*smooth_normals=*/false);
+// cp: the body's closest points to the garment vertices X; body_rest: the body in the first
+// frame, where body parts are told apart.
+Depths penetration(const BodyQuery& body, const ClosestPoints& cp, const Points3& body_rest, const Points3& X,
+                   const ValidityOptions& opt) {
   const Points3& B = body.mesh().V;
   const Faces& F = body.mesh().F;
   const double reach2 = opt.pinch_reach * opt.pinch_reach, sep2 = opt.pinch_separation * opt.pinch_separation;
@@ -113,8 +114,9 @@ bool body_crosses_itself(const Points3& V, const Faces& F, const Points3& rest, 
 // Edges of X (rows of `edges`) with both ends outside the body whose segment runs through it:
 // the middle of its span between the first and the last crossing lies deeper than `depth`
 // metres (validity.hpp; a chord grazing a curved surface dips in by a fraction of that).
-long threaded_edges(const BodyQuery& body, const Points3& X, const Pairs& edges, double depth) {
-  const ClosestPoints cp = body.closest(X, /*smooth_normals=*/false);
+// cp: the body's closest points to X (their signed distances tell the ends outside).
+long threaded_edges(const BodyQuery& body, const ClosestPoints& cp, const Points3& X, const Pairs& edges,
+                    double depth) {
   std::vector<int> out;  // edges with both ends outside
   for (int e = 0; e < edges.rows(); ++e) {
     const int i = edges(e, 0), j = edges(e, 1);
@@ -254,14 +256,17 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
       const Points3& rest = d.body_frames[0];
       const bool crossing = body_crosses_itself(d.body_frames[t], d.body_faces, rest, opt.pinch_separation);
       v.body_crossing_frames += crossing;
-      const Depths lr = penetration(*body, rest, d.lr_frames[t], opt),
-                   hr = penetration(*body, rest, d.hr_frames[t], opt);
+      // One closest-point query per resolution serves the penetration and the threaded edges.
+      const ClosestPoints lr_cp = body->closest(d.lr_frames[t], /*smooth_normals=*/false),
+                          hr_cp = body->closest(d.hr_frames[t], /*smooth_normals=*/false);
+      const Depths lr = penetration(*body, lr_cp, rest, d.lr_frames[t], opt),
+                   hr = penetration(*body, hr_cp, rest, d.hr_frames[t], opt);
       add_penetration(lr, t, opt.penetration_limit, crossing, v.lr);
       add_penetration(hr, t, opt.penetration_limit, crossing, v.hr);
       v.per_frame[t].lr_depth = lr.free;
       v.per_frame[t].hr_depth = hr.free;
-      v.per_frame[t].lr_threaded = threaded_edges(*body, d.lr_frames[t], lr_edges, opt.threaded_depth);
-      v.per_frame[t].hr_threaded = threaded_edges(*body, d.hr_frames[t], hr_edges, opt.threaded_depth);
+      v.per_frame[t].lr_threaded = threaded_edges(*body, lr_cp, d.lr_frames[t], lr_edges, opt.threaded_depth);
+      v.per_frame[t].hr_threaded = threaded_edges(*body, hr_cp, d.hr_frames[t], hr_edges, opt.threaded_depth);
       add_threaded(v.per_frame[t].lr_threaded, t, v.lr);
       add_threaded(v.per_frame[t].hr_threaded, t, v.hr);
     }
