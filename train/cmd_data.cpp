@@ -63,7 +63,7 @@ struct MakeArgs {
   // Solver knobs (NaN / <0: the solver's default, sim::SimParams).
   int iterations = -1, stretch_passes = -1, settle_frames = -1, contact_every = -1, self_detect_every = -1;
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN, self_slack = NAN;
-  double self_slack_per_pd = NAN, untangle_step = NAN;
+  double self_slack_per_pd = NAN, untangle_step = NAN, max_push_step = NAN;
   double track_rate = NAN;  // 1/s: the HR simulation follows the LR one at the LR scale (sim/cloth_tracking.hpp)
   bool self_collision = true;
   bool limbs_pass_through = true;
@@ -194,6 +194,7 @@ void run_make(const MakeArgs& a) {
   if (a.self_detect_every > 0) params.self_detect_every = a.self_detect_every;
   if (!std::isnan(a.compression_ratio)) params.compression_ratio = a.compression_ratio;
   if (!std::isnan(a.untangle_step)) params.untangle_step = a.untangle_step;
+  if (!std::isnan(a.max_push_step)) params.max_push_step = a.max_push_step;
   params.track_rate = effective_track_rate(a);
   params.self_collision = a.self_collision;
   params.limbs_pass_through = a.limbs_pass_through;
@@ -245,6 +246,7 @@ void run_make(const MakeArgs& a) {
                   {"rest_arm_drop_degrees", bo.rest_arm_drop_degrees},
                   {"self_collision", params.self_collision},
                   {"limbs_pass_through", params.limbs_pass_through},
+                  {"max_push_step_m", params.max_push_step},
                   {"self_thickness_m", params.self_thickness},
                   {"self_thickness_per_pd", params.self_thickness_per_pd},
                   {"self_slack_m", params.self_slack},
@@ -646,6 +648,10 @@ void add_data_command(CLI::App& app) {
                    "per substep, the most cloth that went through itself is moved to undo it, in self-thicknesses "
                    "(default: the solver's; 0: off, as before solver revision 12)")
       ->check(finite_range(0.0, 1.0));
+  make->add_option("--max-push-step", mk->max_push_step,
+                   "metres per substep: how much farther than the body's surface a body contact moves cloth that "
+                   "hangs from no pin (default: the solver's; 1: at once, as before solver revision 15)")
+      ->check(finite_range(1e-5, 1.0));
   make->add_option("--track-rate", mk->track_rate,
                    "1/s: HR follows the LR simulation at the LR scale, a difference in drape decaying at this rate, "
                    "and adds finer wrinkles (default: the solver's, 30; 0: independent, as before revision 13)")

@@ -61,6 +61,7 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     gdsr::fail("sim/cloth_solver", "compression_ratio must be in (0, 1]");
   if (!(p.compression_pd_ref > 0)) gdsr::fail("sim/cloth_solver", "compression_pd_ref must be positive");
   if (!(p.contact_release_stretch > 1)) gdsr::fail("sim/cloth_solver", "contact_release_stretch must be > 1");
+  if (!(p.max_push_step > 0)) gdsr::fail("sim/cloth_solver", "max_push_step must be positive");
   if (g.particle_distance > 0)
     p_.compression_ratio =
         std::min(1.0, p.compression_ratio * std::pow(p.compression_pd_ref / g.particle_distance, 2));
@@ -271,7 +272,7 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
     auto add = [&](int v, const SurfaceHit& hit) {
       // Deeper than max_push: the vertex went through a thin part; pushing it out would tear
       // the cloth, so leave it.
-      if (hit.signed_distance > -p_.max_push) found[v][count[v]++] = {v, hit.face, hit.bary};
+      if (hit.signed_distance > -p_.max_push) found[v][count[v]++] = {v, hit.face, hit.bary, !anchored_[v]};
     };
 #pragma omp parallel for schedule(dynamic, 256)
     for (int v = 0; v < nv; ++v) {
@@ -492,16 +493,23 @@ bool ClothSolver::overstretched_at(int v, const Vec3& x) const {
 }
 
 void ClothSolver::solve_body_contacts(const Points3& body_prev, const Points3& body_now) {
+  // A vertex's contacts are consecutive, the part that wins a pinch last: it may undo the push
+  // of the one before.
+  int pushed_v = -1;
+  double pushed = 0;
   for (const auto& c : contacts_) {
+    if (c.v != pushed_v) pushed_v = c.v, pushed = 0;
     const Vec3 q = bary_point(body_now, bodyF_, c.face, c.bary);
     const Vec3 nrm = face_normal(body_now, bodyF_, c.face);
     Vec3 x = x_.row(c.v).transpose();
     const double C = (x - q).dot(nrm) - p_.thickness;
     if (C >= 0) continue;
-    x -= C * nrm;
+    const Vec3 qprev = bary_point(body_prev, bodyF_, c.face, c.bary);
+    const double push = c.gradual ? std::min(-C, std::max(0.0, (q - qprev).dot(nrm)) + p_.max_push_step + pushed) : -C;
+    x += push * nrm;
+    pushed = push;
     if (overstretched_at(c.v, x)) continue;
     // Coulomb friction on the displacement relative to the body point this substep.
-    const Vec3 qprev = bary_point(body_prev, bodyF_, c.face, c.bary);
     Vec3 rel = (x - xprev_.row(c.v).transpose()) - (q - qprev);
     rel -= rel.dot(nrm) * nrm;
     const double rl = rel.norm();
