@@ -648,9 +648,10 @@ void add_data_command(CLI::App& app) {
                    "per substep, the most cloth that went through itself is moved to undo it, in self-thicknesses "
                    "(default: the solver's; 0: off, as before solver revision 12)")
       ->check(finite_range(0.0, 1.0));
-  make->add_option("--max-push-step", mk->max_push_step,
-                   "metres per substep: how much farther than the body's surface a body contact moves cloth that "
-                   "hangs from no pin (default: the solver's; 1: at once, as before solver revision 15)")
+  make->add_option(
+          "--max-push-step", mk->max_push_step,
+          "metres per contact pass (one per iteration): how much farther than the body's surface a body contact "
+          "moves cloth that hangs from no pin (default: the solver's; 1: at once, as before solver revision 15)")
       ->check(finite_range(1e-5, 1.0));
   make->add_option("--track-rate", mk->track_rate,
                    "1/s: HR follows the LR simulation at the LR scale, a difference in drape decaying at this rate, "

@@ -87,7 +87,7 @@ namespace sim {
 //     (SimParams::track_rate). LR frames, and anything simulated without a guide, are unchanged,
 //     bit for bit.
 // 15: a body contact moves cloth that hangs from no pin (the t-shirt, the top) with the body's
-//     surface along its normal plus at most max_push_step per substep (the part that wins a pinch
+//     surface along its normal plus at most max_push_step per contact pass (the part that wins a pinch
 //     may also undo the other part's push). Pushed out in one go, a hem vertex that a forearm had
 //     overtaken within a contact refresh was thrown through to the forearm's far side: the 30 mm
 //     t-shirt on CMU 131_03 (2-3.5 s) had cloth threaded on a forearm in 49 of 61 frames and an
@@ -141,10 +141,11 @@ struct SimParams {
                                    // contacts: the garment hangs on it (a leg in a trouser leg), so letting that part
                                    // through would drop the cloth off the body (on the walks and salsa clips measured,
                                    // every vertex lost this deep was in a hand)
-  double max_push_step = 0.005;    // m per substep: how much farther than the body's surface moved along its normal
-                                   // a body contact moves cloth that hangs from no pin (3 m/s at 20 substeps and 30
-                                   // fps). Unlimited, a vertex a forearm had overtaken was pushed out through the
-                                   // forearm's far side, and the cloth stayed threaded on it (revision 15)
+  double max_push_step = 0.005;    // m per contact pass (one per iteration): how much farther than the body's surface
+                                   // moved along its normal (this substep) a body contact moves cloth that hangs from
+                                   // no pin (6 m/s at 2 iterations, 20 substeps and 30 fps). Unlimited, a vertex a
+                                   // forearm had overtaken was pushed out through the forearm's far side, and the
+                                   // cloth stayed threaded on it (revision 15)
   double pinch_separation = 0.15;  // m: body points this far apart in the first pose are different parts (a hand
                                    // and a hip); cloth pinched between two parts stays on the part it was dressed on
   double max_speed = 15;                         // m/s, velocity clamp (safety against fast body parts)
@@ -244,7 +245,7 @@ class ClothSolver {
   struct Contact {
     int v, face;
     gdsr::Vec3 bary;
-    bool gradual = false;  // pushed out at most max_push_step per substep beyond the body's motion
+    bool gradual = false;  // pushed out at most max_push_step per pass beyond the body's motion
   };
   struct LayerPair {
     int outer, inner;

@@ -345,9 +345,10 @@ int tshirt_walk_torn_frames(double max_push_step) {
 TEST_CASE("cloth: a forearm dropping onto the hip does not thread the t-shirt") {
   // A forearm that overtook a hem vertex between two contact refreshes pushed it out in one go
   // through its far side: the cloth stayed threaded on the forearm, its edges stretched across
-  // it. Moved at most max_push_step per substep, the vertex stays on its side.
+  // it. Moved at most max_push_step per contact pass beyond the body's motion, the vertex stays
+  // on its side.
   const int capped = tshirt_walk_torn_frames(sim::SimParams{}.max_push_step);
-  MESSAGE("frames with an edge > 2x its pattern, push capped at 5 mm per substep: " << capped << " of 46");
+  MESSAGE("frames with an edge > 2x its pattern, push capped at 5 mm per pass: " << capped << " of 46");
   CHECK(capped <= 2);
   const int at_once = tshirt_walk_torn_frames(1e9);  // the test can fail: revision 14's push
   MESSAGE("... pushed out at once: " << at_once << " of 46");
