@@ -272,7 +272,7 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
     auto add = [&](int v, const SurfaceHit& hit) {
       // Deeper than max_push: the vertex went through a thin part; pushing it out would tear
       // the cloth, so leave it.
-      if (hit.signed_distance > -p_.max_push) found[v][count[v]++] = {v, hit.face, hit.bary, !anchored_[v]};
+      if (hit.signed_distance > -p_.max_push) found[v][count[v]++] = {v, hit.face, hit.bary};
     };
 #pragma omp parallel for schedule(dynamic, 256)
     for (int v = 0; v < nv; ++v) {
@@ -493,8 +493,9 @@ bool ClothSolver::overstretched_at(int v, const Vec3& x) const {
 }
 
 void ClothSolver::solve_body_contacts(const Points3& body_prev, const Points3& body_now) {
-  // A vertex's contacts are consecutive, the part that wins a pinch last: it may undo the push
-  // of the one before.
+  // Cloth that hangs from no pin is pushed out gradually (SimParams::max_push_step). A vertex's
+  // contacts are consecutive, the part that wins a pinch last: it may undo the push of the one
+  // before.
   int pushed_v = -1;
   double pushed = 0;
   for (const auto& c : contacts_) {
@@ -505,7 +506,8 @@ void ClothSolver::solve_body_contacts(const Points3& body_prev, const Points3& b
     const double C = (x - q).dot(nrm) - p_.thickness;
     if (C >= 0) continue;
     const Vec3 qprev = bary_point(body_prev, bodyF_, c.face, c.bary);
-    const double push = c.gradual ? std::min(-C, std::max(0.0, (q - qprev).dot(nrm)) + p_.max_push_step + pushed) : -C;
+    const double push =
+        anchored_[c.v] ? -C : std::min(-C, std::max(0.0, (q - qprev).dot(nrm)) + p_.max_push_step + pushed);
     x += push * nrm;
     pushed = push;
     if (overstretched_at(c.v, x)) continue;

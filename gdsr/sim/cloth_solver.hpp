@@ -245,7 +245,6 @@ class ClothSolver {
   struct Contact {
     int v, face;
     gdsr::Vec3 bary;
-    bool gradual = false;  // pushed out at most max_push_step per pass beyond the body's motion
   };
   struct LayerPair {
     int outer, inner;

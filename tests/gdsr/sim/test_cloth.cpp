@@ -133,9 +133,9 @@ TEST_CASE("cloth: cloth pinched between a hand and the torso stays on the torso"
   CHECK(with.depth < 0.0015);
   // Not asserted: a hand that slides while sunk into the torso still ploughs the cloth along
   // (22 mm here since solver revision 15, 39 mm before; 57 mm without telling the parts apart;
-  // 0.3 mm without a hand). Letting the
-  // hand pass through where there is no room fixed this scene (2 mm) but made 01_01 agree
-  // worse (29.9 against 24.6 mm over 1 s), so it is not in the solver.
+  // 0.3 mm without a hand). Letting the hand pass through where there is no room fixed this
+  // scene (2 mm) but made 01_01 agree worse (29.9 against 24.6 mm over 1 s), so it is not in
+  // the solver.
   // Without telling the parts apart the nearest part (the hand) wins: the cloth is pushed
   // into the torso. The test can fail.
   const Pinch without = pinch_scene(100.0);
