@@ -592,7 +592,8 @@ void run_check(const CheckArgs& a) {
 }  // namespace
 
 void add_data_command(CLI::App& app) {
-  CLI::App* data = app.add_subcommand("data", "make, preview, import, check and compare paired LR/HR datasets");
+  CLI::App* data =
+      app.add_subcommand("data", "make, preview, import, check, compare and tabulate paired LR/HR datasets");
   data->require_subcommand(1);
 
   auto mk = std::make_shared<MakeArgs>();
@@ -742,4 +743,5 @@ void add_data_command(CLI::App& app) {
   ch->callback([chk]() { run_check(*chk); });
 
   add_data_compare_command(*data);
+  add_data_table_command(*data);
 }

@@ -8,6 +8,7 @@ class App;
 
 void add_data_command(CLI::App& app);   // train/cmd_data.cpp: gdsr data make|preview|import-md|check
 void add_data_compare_command(CLI::App& data);  // train/cmd_data_compare.cpp: gdsr data compare (under `data`)
+void add_data_table_command(CLI::App& data);    // train/cmd_data_table.cpp: gdsr data table (under `data`)
 void add_train_command(CLI::App& app);  // train/cmd_train.cpp: gdsr train
 void add_infer_command(CLI::App& app);  // infer/cmd_infer.cpp: gdsr infer
 void add_eval_command(CLI::App& app);   // infer/cmd_eval.cpp: gdsr eval

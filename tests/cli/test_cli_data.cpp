@@ -137,6 +137,20 @@ TEST_CASE("cli data: make a tiny dataset, check it and preview a frame") {
   }
   check_one_line_error(gdsr_run(dir, "data preview --data '" + out + "' --frame 999 --out '" + (dir / "q.png") + "'"),
                        "out of range");
+  // The stored figures in a table: the dataset by name, or every dataset in a folder (here the
+  // test's folder, which holds this one dataset among other files).
+  const Run tab = gdsr_run(dir, "data table --data '" + out + "' --out '" + (dir / "t.md") + "'");
+  CHECK(tab.status == 0);
+  CHECK(tab.out.find("| ds | skirt_short | " + std::to_string(gdsr::load_dataset(out).manifest.frames) + " | ") !=
+        std::string::npos);
+  CHECK(tab.out.find("of 1 datasets pass every limit") != std::string::npos);
+  const std::string md = gdsr_test::slurp(dir / "t.md");
+  CHECK(md.rfind("| dataset | garment |", 0) == 0);
+  CHECK(tab.out.find(md) == 0);  // the file holds the table printed
+  const Run folder = gdsr_run(dir, "data table --data '" + dir.path.string() + "'");
+  CHECK(folder.status == 0);
+  CHECK(folder.out.find("| ds | skirt_short |") != std::string::npos);
+  check_one_line_error(gdsr_run(dir, "data table --data '" + (dir / "none") + "'"), "none");
   check_one_line_error(gdsr_run(dir, "data make --garment skirt_short --motion '" + (dir / "none.bvh") + "' --out '" +
                                          (dir / "x") + "'"),
                        "none.bvh");
