@@ -29,7 +29,8 @@ namespace fs = std::filesystem;
 // A dataset folder as given, or, for a folder without a manifest, the datasets in it (a
 // recipe's output), by name.
 std::vector<fs::path> datasets_in(const std::string& path) {
-  const fs::path p(path);
+  fs::path p = fs::path(path).lexically_normal();
+  if (p.filename().empty()) p = p.parent_path();  // "DATA/"
   if (fs::exists(p / "manifest.json")) return {p};
   if (!fs::is_directory(p))
     gdsr::fail("--data " + path, "not a dataset folder (no manifest.json) nor a folder of them");
@@ -52,9 +53,7 @@ void run_table(const TableArgs& a) {
       const std::string manifest = (dir / "manifest.json").string();
       const gdsr::DatasetManifest m = gdsr::read_manifest(manifest);
       if (m.validity.empty())
-        gdsr::fail(manifest,
-                   "no validity figures stored (a dataset made before they existed: `gdsr data check` "
-                   "measures them)");
+        gdsr::fail(manifest, "no validity figures stored (made before they existed; `gdsr data check` prints them)");
       gdsr::ValiditySummaryRow row;
       row.name = dir.filename().string();
       row.garment = m.garment;

@@ -1,5 +1,6 @@
 #include "gdsr/data/validity_summary.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -40,9 +41,9 @@ std::vector<std::string> failed_criteria(const ValidityFigures& v, const Validit
 std::string validity_summary_markdown(const std::vector<ValiditySummaryRow>& rows, const ValidityLimits& lim) {
   std::string s =
       "| dataset | garment | frames | clean LR / HR | E_u LR / HR | E_v LR / HR | E_uv LR / HR | torn LR / HR | "
-      "inside, "
-      "outside pinches: frames LR / HR, deepest mm | pinch frames LR / HR | threaded LR / HR | body crosses itself | "
-      "agreement mm (drape / wrinkles) | HR curvature / upsampled LR | s/frame LR / HR | fails |\n"
+      "inside, outside pinches: frames LR / HR, deepest mm | pinch frames LR / HR | threaded LR / HR | "
+      "body crosses itself | agreement mm (drape / wrinkles) | HR curvature / upsampled LR | s/frame LR / HR | "
+      "fails |\n"
       "|---|---|---:|---|---|---|---|---|---|---|---|---:|---|---:|---|---|\n";
   for (const ValiditySummaryRow& row : rows) {
     const ValidityFigures& v = row.v;

@@ -147,9 +147,10 @@ TEST_CASE("cli data: make a tiny dataset, check it and preview a frame") {
   const std::string md = gdsr_test::slurp(dir / "t.md");
   CHECK(md.rfind("| dataset | garment |", 0) == 0);
   CHECK(tab.out.find(md) == 0);  // the file holds the table printed
-  const Run folder = gdsr_run(dir, "data table --data '" + dir.path.string() + "'");
+  const Run folder = gdsr_run(dir, "data table --data '" + dir.path.string() + "/'");  // a trailing slash too
   CHECK(folder.status == 0);
   CHECK(folder.out.find("| ds | skirt_short |") != std::string::npos);
+  CHECK(gdsr_run(dir, "data table --data '" + out + "/'").out.find("| ds | skirt_short |") != std::string::npos);
   check_one_line_error(gdsr_run(dir, "data table --data '" + (dir / "none") + "'"), "none");
   check_one_line_error(gdsr_run(dir, "data make --garment skirt_short --motion '" + (dir / "none.bvh") + "' --out '" +
                                          (dir / "x") + "'"),
