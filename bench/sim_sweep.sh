@@ -23,6 +23,12 @@
 # - tracking: how closely the HR simulation follows the LR one (0: independent), agreement
 #   against the wrinkles HR adds (curvature over the upsampled LR's), and the cost:
 #     bench/sim_sweep.sh build OUT --track-rate "0 2 5 10" skirt_short /usr/share/assimp/models/BVH/01_01.bvh 1 2
+# - compression: how in-plane compression softens with the particle distance, (0.01 m / pd)^k
+#   (SimParams::compression_pd_exponent), against mean E_u / E_v HR over LR (one fabric: within
+#   2x), torn HR frames, agreement and HR curvature over the upsampled LR (revision 15: k = 2
+#   0.28 / 0.37, 34 torn, 7.2 mm, 1.51x; k = 1 0.54 / 0.52, 20, 9.3 mm, 1.38x; k = 0 0.73 / 0.72,
+#   10, 11.0 mm, 1.31x):
+#     bench/sim_sweep.sh build OUT --compression-exponent "2 1 0" pants ../shared/motions/cmu-salsa/60_02.bvh 2 4
 set -e
 usage="usage: $0 BUILD_DIR OUT_DIR OPTION VALUES [GARMENT] [MOTION] [START_S] [SECONDS] [FLAGS]"
 build=$(cd "${1:?$usage}" && pwd)

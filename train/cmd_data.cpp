@@ -62,7 +62,8 @@ struct MakeArgs {
   int substeps = -1;  // <0: the solver's default
   // Solver knobs (NaN / <0: the solver's default, sim::SimParams).
   int iterations = -1, stretch_passes = -1, settle_frames = -1, contact_every = -1, self_detect_every = -1;
-  double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN, self_slack = NAN;
+  double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN,
+         compression_exponent = NAN, self_slack = NAN;
   double self_slack_per_pd = NAN, untangle_step = NAN, max_push_step = NAN;
   double track_rate = NAN;  // 1/s: the HR simulation follows the LR one at the LR scale (sim/cloth_tracking.hpp)
   bool self_collision = true;
@@ -193,6 +194,7 @@ void run_make(const MakeArgs& a) {
   if (!std::isnan(a.self_slack_per_pd)) params.self_slack_per_pd = a.self_slack_per_pd;
   if (a.self_detect_every > 0) params.self_detect_every = a.self_detect_every;
   if (!std::isnan(a.compression_ratio)) params.compression_ratio = a.compression_ratio;
+  if (!std::isnan(a.compression_exponent)) params.compression_pd_exponent = a.compression_exponent;
   if (!std::isnan(a.untangle_step)) params.untangle_step = a.untangle_step;
   if (!std::isnan(a.max_push_step)) params.max_push_step = a.max_push_step;
   params.track_rate = effective_track_rate(a);
@@ -256,6 +258,7 @@ void run_make(const MakeArgs& a) {
                   {"hr_track_rate_1_s", params.track_rate},
                   {"compression_ratio", params.compression_ratio},
                   {"compression_pd_ref_m", params.compression_pd_ref},
+                  {"compression_pd_exponent", params.compression_pd_exponent},
                   {"clip_start_s", a.start},
                   {"clip_seconds", a.seconds}};
   gdsr::update_manifest_counts(d);
@@ -643,8 +646,12 @@ void add_data_command(CLI::App& app) {
       ->check(CLI::Range(1, 1000));
   make->add_option("--compression-ratio", mk->compression_ratio,
                    "in-plane compression stiffness / stretch stiffness at a 10 mm particle distance, scaled by (0.01 m "
-                   "/ pd)^2 (default: the solver's)")
+                   "/ pd)^k, k: --compression-exponent (default: the solver's)")
       ->check(finite_range(1e-4, 1.0));
+  make->add_option("--compression-exponent", mk->compression_exponent,
+                   "k above (default: the solver's, 2, the Euler buckling load; 1: a 30 mm mesh 3x stiffer in "
+                   "compression, its strain within 2x of a 10 mm one's; 0: one ratio at every particle distance)")
+      ->check(finite_range(0.0, 4.0));
   make->add_option("--untangle-step", mk->untangle_step,
                    "per substep, the most cloth that went through itself is moved to undo it, in self-thicknesses "
                    "(default: the solver's; 0: off, as before solver revision 12)")

@@ -60,11 +60,13 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
   if (!(p.compression_ratio > 0 && p.compression_ratio <= 1))
     gdsr::fail("sim/cloth_solver", "compression_ratio must be in (0, 1]");
   if (!(p.compression_pd_ref > 0)) gdsr::fail("sim/cloth_solver", "compression_pd_ref must be positive");
+  if (!(p.compression_pd_exponent >= 0 && p.compression_pd_exponent <= 4))
+    gdsr::fail("sim/cloth_solver", "compression_pd_exponent must be in [0, 4]");
   if (!(p.contact_release_stretch > 1)) gdsr::fail("sim/cloth_solver", "contact_release_stretch must be > 1");
   if (!(p.max_push_step > 0)) gdsr::fail("sim/cloth_solver", "max_push_step must be positive");
   if (g.particle_distance > 0)
-    p_.compression_ratio =
-        std::min(1.0, p.compression_ratio * std::pow(p.compression_pd_ref / g.particle_distance, 2));
+    p_.compression_ratio = std::min(
+        1.0, p.compression_ratio * std::pow(p.compression_pd_ref / g.particle_distance, p.compression_pd_exponent));
   if (body_F.rows() > 0 && body_F.maxCoeff() >= body_V0.rows())
     gdsr::fail("sim/cloth_solver", "body faces index missing vertices");
   if (!m.V.allFinite()) gdsr::fail("sim/cloth_solver", "garment rest positions are not finite");

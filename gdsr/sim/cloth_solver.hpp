@@ -111,12 +111,21 @@ struct SimParams {
                                     // locking). 5 s of CMU 01_01 at both resolutions: 0.01 drapes LR closer to HR
                                     // (58 against 78 mm) but the 10 mm skirt crumples through itself in the jumps
                                     // (47% clean frames against 100%)
-  double compression_pd_ref = 0.01;  // m. At particle distance pd the ratio is compression_ratio * (ref / pd)^2
-                                     // (at most 1): an element cannot buckle inside itself, and the load a sheet of
-                                     // width pd carries before it buckles falls as bending / pd^2 (Euler), so a
-                                     // coarser mesh resists less. 1 s of skirt_short, 30 mm (0.011) against 10 mm
-                                     // (0.1): HR-LR agreement 31.8 -> 22.8 mm on 01_01, 60.6 -> 33.9 mm on salsa
-                                     // 61_02, LR still free of self-intersections
+  double compression_pd_ref = 0.01;  // m. At particle distance pd the ratio is compression_ratio * (ref / pd)^k
+                                     // (at most 1), k = compression_pd_exponent: an element cannot buckle inside
+                                     // itself, so a coarser mesh takes up its finer folds as in-plane compression
+  // compression_pd_exponent, k above: 2 is the Euler load, bending / pd^2 (0.011 at 30 mm; with HR
+  // simulated on its own, before revision 13, it brought 1 s of skirt_short's HR-LR agreement from
+  // 31.8 to 22.8 mm on CMU 01_01). The 30 mm LR then compresses 3-5x more than the 10 mm HR (mean
+  // E_u HR / LR 0.20 on skirt_short, 01_01; 0.28 on pants, salsa 60_02): not one fabric. 1 (0.033 at
+  // 30 mm): 0.47 and 0.54, HR frames with an edge torn past 2x 34 -> 20 on the pants, HR curvature
+  // over upsampled LR 1.17 -> 1.11x and 1.51 -> 1.38x, agreement 4.1 -> 4.9 and 7.2 -> 9.3 mm; 0 (one
+  // ratio everywhere): 0.51 / 0.73, 1.11x / 1.31x, 6.0 / 11.0 mm (bench/sim_sweep.sh). Not the
+  // default yet: at 1 a 15 mm sheet draped on a sphere tangles (44 intersecting pairs, 5 of 23
+  // frames), a flap held folded through by a guide stays through (44 pairs), and a 2-layer skirt
+  // without self-contact crosses its layers in 168 of 748 vertex-frames (tests of sim/). The sphere
+  // drape is clean again with 3 iterations or 30 substeps (10 mm: clean at both).
+  double compression_pd_exponent = 2;
   double bend_stiffness = 2e-6;     // N m (isometric bending modulus; silk is very soft)
   double damping = 0.5;             // 1/s, velocity decay (air drag)
   gdsr::Vec3 gravity = gdsr::Vec3(0, -9.81, 0);  // m/s^2

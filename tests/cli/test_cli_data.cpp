@@ -225,12 +225,13 @@ TEST_CASE("cli data: compare finds a repeat bit-identical, a nudged twin apart, 
 TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out of range are refused") {
   TempDir dir("cli_knobs");
   const std::string out = dir / "ds";
-  const Run mk = gdsr_run(dir, "data make --garment skirt_short --out '" + out +
-                                   "' --seconds 0.1 --lr-pd 0.08 --hr-pd 0.06 --rest-blend 2 --raster 64"
-                                   " --iterations 3 --friction 0.1 --self-thickness 0.002 --no-self-collision"
-                                   " --compression-ratio 0.5 --settle-frames 3 --contact-every 2"
-                                   " --self-slack 0.002 --self-detect-every 3 --self-slack-per-pd 0.25"
-                                   " --no-limbs-pass-through --untangle-step 0.25 --track-rate 4 --max-push-step 0.01");
+  const Run mk =
+      gdsr_run(dir, "data make --garment skirt_short --out '" + out +
+                        "' --seconds 0.1 --lr-pd 0.08 --hr-pd 0.06 --rest-blend 2 --raster 64"
+                        " --iterations 3 --friction 0.1 --self-thickness 0.002 --no-self-collision"
+                        " --compression-ratio 0.5 --compression-exponent 1.5 --settle-frames 3 --contact-every 2"
+                        " --self-slack 0.002 --self-detect-every 3 --self-slack-per-pd 0.25"
+                        " --no-limbs-pass-through --untangle-step 0.25 --track-rate 4 --max-push-step 0.01");
   REQUIRE(mk.status == 0);
   const std::string manifest = gdsr_test::slurp(out + "/manifest.json");
   CHECK(manifest.find("\"iterations\": 3") != std::string::npos);
@@ -238,6 +239,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"self_collision\": false") != std::string::npos);
   CHECK(manifest.find("\"self_thickness_m\": 0.002") != std::string::npos);
   CHECK(manifest.find("\"compression_ratio\": 0.5") != std::string::npos);
+  CHECK(manifest.find("\"compression_pd_exponent\": 1.5") != std::string::npos);
   CHECK(manifest.find("\"settle_frames\": 3") != std::string::npos);
   CHECK(manifest.find("\"contact_every\": 2") != std::string::npos);
   CHECK(manifest.find("\"self_slack_m\": 0.002") != std::string::npos);
@@ -249,8 +251,9 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"max_push_step_m\": 0.01") != std::string::npos);
   for (const std::string bad :
        {"--iterations 0", "--friction -1", "--self-thickness 1", "--bend-stiffness -2", "--compression-ratio 0",
-        "--settle-frames -1", "--contact-every 0", "--self-slack 0", "--self-detect-every 0", "--self-slack-per-pd 0",
-        "--untangle-step -0.1", "--track-rate -1", "--track-rate nan", "--max-push-step 0"}) {
+        "--compression-exponent -1", "--compression-exponent 5", "--settle-frames -1", "--contact-every 0",
+        "--self-slack 0", "--self-detect-every 0", "--self-slack-per-pd 0", "--untangle-step -0.1", "--track-rate -1",
+        "--track-rate nan", "--max-push-step 0"}) {
     const Run r = gdsr_run(dir, "data make --out '" + (dir / "bad") + "' " + bad);
     CHECK(r.status == 1);  // a refusal, not a crash (a sanitizer report exits 99)
     CHECK(r.err.find(bad.substr(0, bad.find(' '))) != std::string::npos);
