@@ -29,6 +29,11 @@
 #   0.28 / 0.37, 34 torn, 7.2 mm, 1.51x; k = 1 0.54 / 0.52, 20, 9.3 mm, 1.38x; k = 0 0.73 / 0.72,
 #   10, 11.0 mm, 1.31x):
 #     bench/sim_sweep.sh build OUT --compression-exponent "2 1 0" pants ../shared/motions/cmu-salsa/60_02.bvh 2 4
+# - self-contact passes per iteration, on the 30 mm pants twice (--hr-pd 0.03: the "HR" is a 30 mm
+#   run following the LR one) at k = 1 (revision 16: LR frames free of self-intersections 100%,
+#   97.8% and 69.1% for 1, 2 and 3 passes; at k = 2 100% for all three):
+#     bench/sim_sweep.sh build OUT --self-passes "1 2 3" pants ../shared/motions/cmu-salsa/61_03.bvh 2 4 \
+#       "--hr-pd 0.03 --compression-exponent 1"
 set -e
 usage="usage: $0 BUILD_DIR OUT_DIR OPTION VALUES [GARMENT] [MOTION] [START_S] [SECONDS] [FLAGS]"
 build=$(cd "${1:?$usage}" && pwd)

@@ -61,7 +61,8 @@ struct MakeArgs {
   double fps = 30;
   int substeps = -1;  // <0: the solver's default
   // Solver knobs (NaN / <0: the solver's default, sim::SimParams).
-  int iterations = -1, stretch_passes = -1, settle_frames = -1, contact_every = -1, self_detect_every = -1;
+  int iterations = -1, stretch_passes = -1, settle_frames = -1, contact_every = -1, self_detect_every = -1,
+      self_passes = -1;
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN,
          compression_exponent = NAN, self_slack = NAN;
   double self_slack_per_pd = NAN, untangle_step = NAN, max_push_step = NAN;
@@ -193,6 +194,7 @@ void run_make(const MakeArgs& a) {
   if (!std::isnan(a.self_slack)) params.self_slack = a.self_slack;
   if (!std::isnan(a.self_slack_per_pd)) params.self_slack_per_pd = a.self_slack_per_pd;
   if (a.self_detect_every > 0) params.self_detect_every = a.self_detect_every;
+  if (a.self_passes > 0) params.self_passes = a.self_passes;
   if (!std::isnan(a.compression_ratio)) params.compression_ratio = a.compression_ratio;
   if (!std::isnan(a.compression_exponent)) params.compression_pd_exponent = a.compression_exponent;
   if (!std::isnan(a.untangle_step)) params.untangle_step = a.untangle_step;
@@ -254,6 +256,7 @@ void run_make(const MakeArgs& a) {
                   {"self_slack_m", params.self_slack},
                   {"self_slack_per_pd", params.self_slack_per_pd},
                   {"self_detect_every", params.self_detect_every},
+                  {"self_passes", params.self_passes},
                   {"untangle_step", params.untangle_step},
                   {"hr_track_rate_1_s", params.track_rate},
                   {"compression_ratio", params.compression_ratio},
@@ -644,6 +647,10 @@ void add_data_command(CLI::App& app) {
   make->add_option("--self-detect-every", mk->self_detect_every,
                    "substeps between self-contact detections (default: the solver's)")
       ->check(CLI::Range(1, 1000));
+  make->add_option("--self-passes", mk->self_passes,
+                   "self-contact passes per iteration, stopping early when no contact is violated (default: the "
+                   "solver's)")
+      ->check(CLI::Range(1, 100));
   make->add_option("--compression-ratio", mk->compression_ratio,
                    "in-plane compression stiffness / stretch stiffness at a 10 mm particle distance, scaled by (0.01 m "
                    "/ pd)^k, k: --compression-exponent (default: the solver's)")

@@ -357,14 +357,16 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
             }
           }
         }
-    // With self-contact (revision 9): only layers lying flat on each other are paired (normals
-    // within 60 degrees, the outer vertex on the inner one's outer side); across a fold the
-    // nearest inner vertex may face any way, and pushing along its normal drove the outer
-    // layer through the inner one (the 10 mm layered dress on CMU 01_01 tangled at the hip
-    // and blew up). Self-contact guards the rest.
-    if (self_ && best >= 0 &&
-        (N.row(v).dot(N.row(best)) < 0.5 * N.row(v).norm() * N.row(best).norm() ||
-         (x_.row(v) - x_.row(best)).dot(N.row(best)) < 0))
+    // Only layers lying flat on each other are paired (normals within 60 degrees): across a
+    // fold the nearest inner vertex may face any way, and pushing along its normal drove the
+    // outer layer through the inner one (revision 9: the 10 mm layered dress on CMU 01_01
+    // tangled at the hip and blew up; without self-contact, the 40 mm layered skirt at rest
+    // with compression_pd_exponent 1 wound its overskirt inside the underskirt). With
+    // self-contact, also only an outer vertex on the inner one's outer side: self-contact
+    // guards the rest. Without it, pairing is the only way back out, so one found inside is
+    // paired (and pushed out).
+    if (best >= 0 && (N.row(v).dot(N.row(best)) < 0.5 * N.row(v).norm() * N.row(best).norm() ||
+                      (self_ && (x_.row(v) - x_.row(best)).dot(N.row(best)) < 0)))
       continue;
     if (best >= 0 && N.row(best).norm() > 0) layer_pairs_.push_back({v, best, N.row(best).normalized().transpose()});
   }

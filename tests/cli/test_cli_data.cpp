@@ -230,7 +230,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
                         "' --seconds 0.1 --lr-pd 0.08 --hr-pd 0.06 --rest-blend 2 --raster 64"
                         " --iterations 3 --friction 0.1 --self-thickness 0.002 --no-self-collision"
                         " --compression-ratio 0.5 --compression-exponent 1.5 --settle-frames 3 --contact-every 2"
-                        " --self-slack 0.002 --self-detect-every 3 --self-slack-per-pd 0.25"
+                        " --self-slack 0.002 --self-detect-every 3 --self-slack-per-pd 0.25 --self-passes 2"
                         " --no-limbs-pass-through --untangle-step 0.25 --track-rate 4 --max-push-step 0.01");
   REQUIRE(mk.status == 0);
   const std::string manifest = gdsr_test::slurp(out + "/manifest.json");
@@ -244,6 +244,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"contact_every\": 2") != std::string::npos);
   CHECK(manifest.find("\"self_slack_m\": 0.002") != std::string::npos);
   CHECK(manifest.find("\"self_detect_every\": 3") != std::string::npos);
+  CHECK(manifest.find("\"self_passes\": 2") != std::string::npos);
   CHECK(manifest.find("\"self_slack_per_pd\": 0.25") != std::string::npos);
   CHECK(manifest.find("\"limbs_pass_through\": false") != std::string::npos);
   CHECK(manifest.find("\"untangle_step\": 0.25") != std::string::npos);
@@ -252,8 +253,8 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   for (const std::string bad :
        {"--iterations 0", "--friction -1", "--self-thickness 1", "--bend-stiffness -2", "--compression-ratio 0",
         "--compression-exponent -1", "--compression-exponent 5", "--settle-frames -1", "--contact-every 0",
-        "--self-slack 0", "--self-detect-every 0", "--self-slack-per-pd 0", "--untangle-step -0.1", "--track-rate -1",
-        "--track-rate nan", "--max-push-step 0"}) {
+        "--self-slack 0", "--self-detect-every 0", "--self-passes 0", "--self-slack-per-pd 0", "--untangle-step -0.1",
+        "--track-rate -1", "--track-rate nan", "--max-push-step 0"}) {
     const Run r = gdsr_run(dir, "data make --out '" + (dir / "bad") + "' " + bad);
     CHECK(r.status == 1);  // a refusal, not a crash (a sanitizer report exits 99)
     CHECK(r.err.find(bad.substr(0, bad.find(' '))) != std::string::npos);
