@@ -15,6 +15,12 @@ std::string format(const char* fmt, double a, double b) {
 
 bool within_ratio(double r, double limit) { return std::isnan(r) || (r <= limit && r >= 1 / limit); }
 
+// "0.84x" for hr / lr, "-" when either is not measured (NaN, datasets made before the split) or lr is 0.
+std::string ratio_or_dash(double hr, double lr) {
+  if (!(lr > 0) || !std::isfinite(hr)) return "-";
+  return format("%.2fx", hr / lr, 0);
+}
+
 }  // namespace
 
 std::vector<std::string> failed_criteria(const ValidityFigures& v, const ValidityLimits& lim) {
@@ -40,11 +46,12 @@ std::vector<std::string> failed_criteria(const ValidityFigures& v, const Validit
 
 std::string validity_summary_markdown(const std::vector<ValiditySummaryRow>& rows, const ValidityLimits& lim) {
   std::string s =
-      "| dataset | garment | frames | clean LR / HR | E_u LR / HR | E_v LR / HR | E_uv LR / HR | torn LR / HR | "
+      "| dataset | garment | frames | clean LR / HR | E_u LR / HR | E_v LR / HR | E_uv LR / HR | "
+      "stretched fibres HR / LR: E_u, E_v | torn LR / HR | "
       "inside, outside pinches: frames LR / HR, deepest mm | pinch frames LR / HR | threaded LR / HR | "
       "body crosses itself | agreement mm (drape / wrinkles) | HR curvature / upsampled LR | s/frame LR / HR | "
       "fails |\n"
-      "|---|---|---:|---|---|---|---|---|---|---|---|---:|---|---:|---|---|\n";
+      "|---|---|---:|---|---|---|---|---|---|---|---|---|---:|---|---:|---|---|\n";
   for (const ValiditySummaryRow& row : rows) {
     const ValidityFigures& v = row.v;
     const ResolutionValidity &L = v.lr, &H = v.hr;
@@ -54,6 +61,8 @@ std::string validity_summary_markdown(const std::vector<ValiditySummaryRow>& row
          format("%.1f / %.1f%%", 100 * L.si_clean_fraction(), 100 * H.si_clean_fraction()) + " | " +
          format("%.4f / %.4f", L.strain.E_u, H.strain.E_u) + " | " + format("%.4f / %.4f", L.strain.E_v, H.strain.E_v) +
          " | " + format("%.4f / %.4f", L.strain.E_uv, H.strain.E_uv) + " | " +
+         ratio_or_dash(H.strain.E_u_stretched, L.strain.E_u_stretched) + ", " +
+         ratio_or_dash(H.strain.E_v_stretched, L.strain.E_v_stretched) + " | " +
          format("%.0f / %.0f", L.torn_frames, H.torn_frames) + " | ";
     if (v.body_measured)
       s += format("%.0f / %.0f", L.frames_over_limit_free, H.frames_over_limit_free) +
