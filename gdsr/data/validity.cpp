@@ -192,6 +192,8 @@ std::string validity_per_frame_csv(const ValidityFigures& v) {
 double ValidityFigures::strain_ratio_u() const { return ratio(hr.strain.E_u, lr.strain.E_u); }
 double ValidityFigures::strain_ratio_v() const { return ratio(hr.strain.E_v, lr.strain.E_v); }
 double ValidityFigures::strain_ratio_uv() const { return ratio(hr.strain.E_uv, lr.strain.E_uv); }
+double ValidityFigures::stretched_ratio_u() const { return ratio(hr.strain.E_u_stretched, lr.strain.E_u_stretched); }
+double ValidityFigures::stretched_ratio_v() const { return ratio(hr.strain.E_v_stretched, lr.strain.E_v_stretched); }
 
 ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, const ProgressFn& progress) {
   if (opt.intersection_stride < 1) fail("validity", "intersection stride must be >= 1");
@@ -468,9 +470,9 @@ std::string validity_table(const ValidityFigures& v) {
        ratio_str(v.strain_ratio_uv()).c_str());
   if (!std::isnan(v.lr.strain.E_u_stretched) && !std::isnan(v.hr.strain.E_u_stretched)) {
     line("  %-40s %14.5f %14.5f %9s\n", "  of E_u: stretched fibres", v.lr.strain.E_u_stretched,
-         v.hr.strain.E_u_stretched, ratio_str(ratio(v.hr.strain.E_u_stretched, v.lr.strain.E_u_stretched)).c_str());
+         v.hr.strain.E_u_stretched, ratio_str(v.stretched_ratio_u()).c_str());
     line("  %-40s %14.5f %14.5f %9s\n", "  of E_v: stretched fibres", v.lr.strain.E_v_stretched,
-         v.hr.strain.E_v_stretched, ratio_str(ratio(v.hr.strain.E_v_stretched, v.lr.strain.E_v_stretched)).c_str());
+         v.hr.strain.E_v_stretched, ratio_str(v.stretched_ratio_v()).c_str());
   }
   if (v.lr.torn_frames >= 0 && v.hr.torn_frames >= 0) {
     auto longest = [](const ResolutionValidity& r) {

@@ -117,6 +117,9 @@ struct ValidityFigures {
   double strain_ratio_u() const;
   double strain_ratio_v() const;
   double strain_ratio_uv() const;
+  // HR / LR of the stretched-fibre part of E_u / E_v (NaN as above, or when not measured)
+  double stretched_ratio_u() const;
+  double stretched_ratio_v() const;
 };
 
 // Computes every figure from the dataset (frames must be loaded). Throws gdsr::Error on a

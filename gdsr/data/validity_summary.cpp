@@ -15,11 +15,8 @@ std::string format(const char* fmt, double a, double b) {
 
 bool within_ratio(double r, double limit) { return std::isnan(r) || (r <= limit && r >= 1 / limit); }
 
-// "0.84x" for hr / lr, "-" when either is not measured (NaN, datasets made before the split) or lr is 0.
-std::string ratio_or_dash(double hr, double lr) {
-  if (!(lr > 0) || !std::isfinite(hr)) return "-";
-  return format("%.2fx", hr / lr, 0);
-}
+// "0.84x", or "-" for NaN (not measured: datasets made before the split, or nothing in LR).
+std::string ratio_or_dash(double r) { return std::isnan(r) ? "-" : format("%.2fx", r, 0); }
 
 }  // namespace
 
@@ -60,10 +57,9 @@ std::string validity_summary_markdown(const std::vector<ValiditySummaryRow>& row
     s += "| " + row.name + " | " + row.garment + " | " + std::to_string(v.frames) + " | " +
          format("%.1f / %.1f%%", 100 * L.si_clean_fraction(), 100 * H.si_clean_fraction()) + " | " +
          format("%.4f / %.4f", L.strain.E_u, H.strain.E_u) + " | " + format("%.4f / %.4f", L.strain.E_v, H.strain.E_v) +
-         " | " + format("%.4f / %.4f", L.strain.E_uv, H.strain.E_uv) + " | " +
-         ratio_or_dash(H.strain.E_u_stretched, L.strain.E_u_stretched) + ", " +
-         ratio_or_dash(H.strain.E_v_stretched, L.strain.E_v_stretched) + " | " +
-         format("%.0f / %.0f", L.torn_frames, H.torn_frames) + " | ";
+         " | " + format("%.4f / %.4f", L.strain.E_uv, H.strain.E_uv) + " | " + ratio_or_dash(v.stretched_ratio_u()) +
+         ", " + ratio_or_dash(v.stretched_ratio_v()) + " | " + format("%.0f / %.0f", L.torn_frames, H.torn_frames) +
+         " | ";
     if (v.body_measured)
       s += format("%.0f / %.0f", L.frames_over_limit_free, H.frames_over_limit_free) +
            format(", %.0f | ", 1e3 * std::max(L.max_penetration_free, H.max_penetration_free), 0) +
