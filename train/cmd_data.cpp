@@ -69,6 +69,7 @@ struct MakeArgs {
   double track_rate = NAN;  // 1/s: the HR simulation follows the LR one at the LR scale (sim/cloth_tracking.hpp)
   bool self_collision = true;
   bool limbs_pass_through = true;
+  bool limbs_pass_until_clear = true;
   bool independent_hr = false;  // settle HR from its own placement, not from the settled LR garment
   bool skip_built = false;      // keep --out when it already holds this clip, built and valid
   int rest_blend_frames = 15;
@@ -202,6 +203,7 @@ void run_make(const MakeArgs& a) {
   params.track_rate = effective_track_rate(a);
   params.self_collision = a.self_collision;
   params.limbs_pass_through = a.limbs_pass_through;
+  params.limbs_pass_until_clear = a.limbs_pass_until_clear;
   sim::Garment lr_garment = sim::make_garment(a.garment, a.lr_pd, body.rest_mesh());
   sim::Garment hr_garment = sim::make_garment(a.garment, a.hr_pd, body.rest_mesh());
   gdsr::Dataset d;
@@ -250,6 +252,7 @@ void run_make(const MakeArgs& a) {
                   {"rest_arm_drop_degrees", bo.rest_arm_drop_degrees},
                   {"self_collision", params.self_collision},
                   {"limbs_pass_through", params.limbs_pass_through},
+                  {"limbs_pass_until_clear", params.limbs_pass_until_clear},
                   {"max_push_step_m", params.max_push_step},
                   {"self_thickness_m", params.self_thickness},
                   {"self_thickness_per_pd", params.self_thickness_per_pd},
@@ -682,6 +685,9 @@ void add_data_command(CLI::App& app) {
   make->add_flag("!--no-limbs-pass-through", mk->limbs_pass_through,
                  "keep body contacts around cloth that a hand went through, so the hand carries it (solver "
                  "revision 10)");
+  make->add_flag("!--no-limbs-pass-until-clear", mk->limbs_pass_until_clear,
+                 "put cloth that a hand went through back in full contact with the hand once it is less "
+                 "than 2 cm inside, so the hand pushes it on (solver revision 16)");
   make->add_flag("--independent-hr", mk->independent_hr,
                  "settle the HR garment from its own placement instead of from the settled LR garment (solver "
                  "revision 3; the resolutions then start the clip with their folds in different places)");

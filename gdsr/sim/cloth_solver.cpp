@@ -181,6 +181,7 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
   }
   // Cloth that hangs from a pin: connected to one through the mesh (see overstretched_at).
   anchored_.assign(nv, 0);
+  lost_in_ = Points3::Constant(nv, 3, std::numeric_limits<double>::quiet_NaN());
   std::vector<int> reached(g.pinned.begin(), g.pinned.end());
   for (int v : reached) anchored_[v] = 1;
   for (size_t k = 0; k < reached.size(); ++k) {
@@ -242,22 +243,56 @@ void ClothSolver::place_pins(const Points3& body) {
   pins_.place(body, x_);
 }
 
-void ClothSolver::drop_part_contacts_around(const Contact& lost, std::vector<std::array<Contact, 2>>& found,
-                                            std::vector<signed char>& count) const {
+bool ClothSolver::part_contacts(int u, const Vec3& part, bool drop, std::vector<std::array<Contact, 2>>& found,
+                                std::vector<signed char>& count) const {
   const double sep2 = p_.pinch_separation * p_.pinch_separation;
-  const Vec3 part = bary_point(body_rest_, bodyF_, lost.face, lost.bary);
-  auto drop = [&](int u) {
-    int kept = 0;
-    for (int k = 0; k < count[u]; ++k)
-      if ((bary_point(body_rest_, bodyF_, found[u][k].face, found[u][k].bary) - part).squaredNorm() > sep2)
-        found[u][kept++] = found[u][k];
-    count[u] = static_cast<signed char>(kept);
-  };
-  drop(lost.v);
-  for (int k = vertex_edges_.offsets[lost.v]; k < vertex_edges_.offsets[lost.v + 1]; ++k) {
-    const Edge& e = edges_[vertex_edges_.items[k]];
-    drop(e.i == lost.v ? e.j : e.i);
+  int kept = 0;
+  bool any = false;
+  for (int k = 0; k < count[u]; ++k) {
+    Contact c = found[u][k];
+    const bool in_part = (bary_point(body_rest_, bodyF_, c.face, c.bary) - part).squaredNorm() <= sep2;
+    any = any || in_part;
+    if (in_part && drop) continue;
+    c.passing = c.passing || in_part;
+    found[u][kept++] = c;
   }
+  count[u] = static_cast<signed char>(kept);
+  return any;
+}
+
+void ClothSolver::pass_limbs_through(const std::vector<Contact>& pierced, std::vector<std::array<Contact, 2>>& found,
+                                     std::vector<signed char>& count) {
+  const int nv = static_cast<int>(x_.rows());
+  const double sep2 = p_.pinch_separation * p_.pinch_separation;
+  // Per vertex: the part (a point of it in the first pose) whose contacts v and its edge
+  // neighbours drop (lost in it now) or hold as passing (lost in it before, still within reach).
+  Points3 lost = Points3::Constant(nv, 3, std::numeric_limits<double>::quiet_NaN());
+  std::vector<char> deep(nv, 0);
+  for (int v = 0; v < nv; ++v) {
+    if (pierced[v].v >= 0) {
+      lost.row(v) = bary_point(body_rest_, bodyF_, pierced[v].face, pierced[v].bary).transpose();
+      deep[v] = 1;
+      continue;
+    }
+    if (!p_.limbs_pass_until_clear || !lost_in_.row(v).allFinite()) continue;
+    for (int k = 0; k < count[v]; ++k)
+      if ((bary_point(body_rest_, bodyF_, found[v][k].face, found[v][k].bary) - lost_in_.row(v).transpose())
+              .squaredNorm() <= sep2)
+        lost.row(v) = lost_in_.row(v);
+  }
+  Points3 next = lost;  // the memory for the next refresh: what is lost now, and the neighbours it reaches
+  for (int v = 0; v < nv; ++v) {
+    if (!lost.row(v).allFinite()) continue;
+    const Vec3 part = lost.row(v).transpose();
+    part_contacts(v, part, deep[v], found, count);
+    for (int k = vertex_edges_.offsets[v]; k < vertex_edges_.offsets[v + 1]; ++k) {
+      const Edge& e = edges_[vertex_edges_.items[k]];
+      const int u = e.i == v ? e.j : e.i;
+      if (part_contacts(u, part, deep[v], found, count) && anchored_[u] && !next.row(u).allFinite())
+        next.row(u) = part.transpose();
+    }
+  }
+  if (p_.limbs_pass_until_clear) lost_in_ = std::move(next);
 }
 
 void ClothSolver::refresh_contacts(const Points3& body_now) {
@@ -311,9 +346,7 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
       add(v, a_home ? b : a);
       add(v, a_home ? a : b);
     }
-    if (p_.limbs_pass_through)
-      for (const Contact& lost : pierced)
-        if (lost.v >= 0) drop_part_contacts_around(lost, found, count);
+    if (p_.limbs_pass_through) pass_limbs_through(pierced, found, count);
     for (int v = 0; v < nv; ++v)
       for (int k = 0; k < count[v]; ++k) contacts_.push_back(found[v][k]);
   }
@@ -510,17 +543,19 @@ void ClothSolver::solve_body_contacts(const Points3& body_prev, const Points3& b
     const double C = (x - q).dot(nrm) - p_.thickness;
     if (C >= 0) continue;
     const Vec3 qprev = bary_point(body_prev, bodyF_, c.face, c.bary);
+    if (c.passing && (q - qprev).dot(nrm) > 0) continue;  // a limb that went through it does not push it on
     const double push =
         anchored_[c.v] ? -C : std::min(-C, std::max(0.0, (q - qprev).dot(nrm)) + p_.max_push_step + pushed);
     x += push * nrm;
     pushed = push;
     if (overstretched_at(c.v, x)) continue;
-    // Coulomb friction on the displacement relative to the body point this substep.
+    // Coulomb friction on the displacement relative to the body point this substep (none from
+    // a part passing through the cloth: it would drag the cloth along).
     Vec3 rel = (x - xprev_.row(c.v).transpose()) - (q - qprev);
     rel -= rel.dot(nrm) * nrm;
     const double rl = rel.norm();
     const double lim = p_.friction * (-C);
-    if (rl > 0) x -= (rl <= lim ? 1.0 : lim / rl) * rel;
+    if (rl > 0 && !c.passing) x -= (rl <= lim ? 1.0 : lim / rl) * rel;
     x_.row(c.v) = x.transpose();
   }
 }
