@@ -194,7 +194,11 @@ struct SimParams {
                                        // on 131_02 24.3 -> 100%, on 61_03 77.2 -> 98.5%, dress_layered on 60_02 100
                                        // -> 99.3%, the rest 100% as before. Dropping those contacts until clear
                                        // instead, on 15 of the clips: 73 -> 36 threaded, 439 -> 368 inside (passing:
-                                       // 29 and 319)
+                                       // 29 and 319). With the friction nudged to 0.30001 and 0.30002 (LR, frames
+                                       // inside): skirt_tiered on 131_02 was lifted in 2 of 3 runs (115, 23, 118), now
+                                       // in none (18, 17, 15); skirt_pleated on 131_02 is systematically worse (6, 4, 6
+                                       // -> 15, 13, 13: a hanging hand stays in the skirt's side where it used to be
+                                       // pushed out), skirt_short on 61_03 within the spread (2, 3, 2 -> 8, 3, 1)
   double max_push_step = 0.005;    // m per contact pass (one per iteration): how much farther than the body's surface
                                    // moved along its normal (this substep) a body contact moves cloth that hangs from
                                    // no pin (6 m/s at 2 iterations, 20 substeps and 30 fps). Unlimited, a vertex a
