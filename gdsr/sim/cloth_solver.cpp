@@ -243,14 +243,18 @@ void ClothSolver::place_pins(const Points3& body) {
   pins_.place(body, x_);
 }
 
+bool ClothSolver::in_part(const Contact& c, const Vec3& part) const {
+  return (bary_point(body_rest_, bodyF_, c.face, c.bary) - part).squaredNorm() <=
+         p_.pinch_separation * p_.pinch_separation;
+}
+
 bool ClothSolver::part_contacts(int u, const Vec3& part, bool drop, std::vector<std::array<Contact, 2>>& found,
                                 std::vector<signed char>& count) const {
-  const double sep2 = p_.pinch_separation * p_.pinch_separation;
   int kept = 0;
   bool any = false;
   for (int k = 0; k < count[u]; ++k) {
     Contact c = found[u][k];
-    const bool in_part = (bary_point(body_rest_, bodyF_, c.face, c.bary) - part).squaredNorm() <= sep2;
+    const bool in_part = this->in_part(c, part);
     any = any || in_part;
     if (in_part && drop) continue;
     c.passing = c.passing || in_part;
@@ -263,7 +267,8 @@ bool ClothSolver::part_contacts(int u, const Vec3& part, bool drop, std::vector<
 void ClothSolver::pass_limbs_through(const std::vector<Contact>& pierced, std::vector<std::array<Contact, 2>>& found,
                                      std::vector<signed char>& count) {
   const int nv = static_cast<int>(x_.rows());
-  const double sep2 = p_.pinch_separation * p_.pinch_separation;
+  if (remembered_ == 0 && std::none_of(pierced.begin(), pierced.end(), [](const Contact& c) { return c.v >= 0; }))
+    return;  // nothing lost in a part: the common case, on every refresh
   // Per vertex: the part (a point of it in the first pose) whose contacts v and its edge
   // neighbours drop (lost in it now) or hold as passing (lost in it before, still within reach).
   Points3 lost = Points3::Constant(nv, 3, std::numeric_limits<double>::quiet_NaN());
@@ -276,9 +281,7 @@ void ClothSolver::pass_limbs_through(const std::vector<Contact>& pierced, std::v
     }
     if (!p_.limbs_pass_until_clear || !lost_in_.row(v).allFinite()) continue;
     for (int k = 0; k < count[v]; ++k)
-      if ((bary_point(body_rest_, bodyF_, found[v][k].face, found[v][k].bary) - lost_in_.row(v).transpose())
-              .squaredNorm() <= sep2)
-        lost.row(v) = lost_in_.row(v);
+      if (in_part(found[v][k], lost_in_.row(v).transpose())) lost.row(v) = lost_in_.row(v);
   }
   Points3 next = lost;  // the memory for the next refresh: what is lost now, and the neighbours it reaches
   for (int v = 0; v < nv; ++v) {
@@ -292,7 +295,10 @@ void ClothSolver::pass_limbs_through(const std::vector<Contact>& pierced, std::v
         next.row(u) = part.transpose();
     }
   }
-  if (p_.limbs_pass_until_clear) lost_in_ = std::move(next);
+  if (!p_.limbs_pass_until_clear) return;
+  lost_in_ = std::move(next);
+  remembered_ = 0;
+  for (int v = 0; v < nv; ++v) remembered_ += lost_in_.row(v).allFinite();
 }
 
 void ClothSolver::refresh_contacts(const Points3& body_now) {

@@ -319,6 +319,8 @@ class ClothSolver {
   };
 
   void refresh_contacts(const gdsr::Points3& body_now);
+  // Whether contact c is with the body part around `part` (within pinch_separation of it in the first pose).
+  bool in_part(const Contact& c, const gdsr::Vec3& part) const;
   // The contacts of vertex u with the body part around `part` (body points within
   // pinch_separation of it in the first pose): removed with `drop`, else marked passing; true
   // when there were some.
@@ -365,6 +367,7 @@ class ClothSolver {
   gdsr::Points3 home_;                     // per cloth vertex: closest body point in the first pose (NaN: none)
   gdsr::Points3 lost_in_;                  // per cloth vertex: a first-pose point of the part a limb passing through
                                            // it belongs to (NaN: none; see limbs_pass_until_clear)
+  int remembered_ = 0;                     // rows of lost_in_ that are set
   std::vector<LayerPair> layer_pairs_;
   SurfaceGrid grid_;
   double body_cell_ = 0.05;

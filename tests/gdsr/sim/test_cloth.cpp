@@ -211,14 +211,23 @@ namespace {
 // middle, its centre 25 mm in front of it, and the other where it was: the middle vertex is about
 // 23 mm inside (deeper than max_push, within the contact search). Returns the body contacts found
 // at the frame's start and the cloth after the frame.
-std::pair<int, Points3> pierce_scene(int moved, bool limbs_pass_through) {
-  const double R = 0.05;
+constexpr double kSphereR = 0.05;  // m, the hanger, home and hand spheres of the hanging sheet
+const Vec3 kHanger(0, 0.15 + kSphereR + 0.01, 0);
+
+// The 30 cm sheet at 20 mm, in the plane z = 0 around the origin, its top edge pinned.
+sim::Garment hanging_sheet() {
   sim::Garment g = square_cloth(0.3, 0.02, 0.0);
   for (int v = 0; v < g.mesh.V.rows(); ++v) {
     g.mesh.V.row(v) = Vec3(g.mesh.V(v, 0), g.mesh.V(v, 2), 0).transpose();
     if (g.mesh.V(v, 1) > 0.15 - 1e-9) g.pinned.push_back(v);
   }
-  const Vec3 hanger(0, 0.15 + R + 0.01, 0), home(0, 0, -0.05 - R), hand(0.5, 0, 0), across(0, 0, R - 0.025);
+  return g;
+}
+
+std::pair<int, Points3> pierce_scene(int moved, bool limbs_pass_through) {
+  const double R = kSphereR;
+  const sim::Garment g = hanging_sheet();
+  const Vec3 hanger = kHanger, home(0, 0, -0.05 - R), hand(0.5, 0, 0), across(0, 0, R - 0.025);
   auto body_with = [&](const Vec3& h, const Vec3& k) {
     return sim::merge_meshes(sim::merge_meshes(sim::make_sphere(hanger, R, 12, 24), sim::make_sphere(h, R, 12, 24)),
                              sim::make_sphere(k, R, 12, 24));
@@ -256,18 +265,12 @@ namespace {
 // per frame (0.45 m/s), to 20 cm behind it. Returns how far the hand carries the middle of the
 // sheet along (-z), at most over the frames, metres.
 double hand_through_sheet_carry(bool until_clear) {
-  const double R = 0.05;
-  sim::Garment g = square_cloth(0.3, 0.02, 0.0);
-  for (int v = 0; v < g.mesh.V.rows(); ++v) {
-    g.mesh.V.row(v) = Vec3(g.mesh.V(v, 0), g.mesh.V(v, 2), 0).transpose();
-    if (g.mesh.V(v, 1) > 0.15 - 1e-9) g.pinned.push_back(v);
-  }
+  const sim::Garment g = hanging_sheet();
   int middle = 0;
   for (int v = 0; v < g.mesh.V.rows(); ++v)
     if (g.mesh.V.row(v).norm() < g.mesh.V.row(middle).norm()) middle = v;
-  const Vec3 hanger(0, 0.15 + R + 0.01, 0);
   auto body_at = [&](const Vec3& hand) {
-    return sim::merge_meshes(sim::make_sphere(hanger, R, 12, 24), sim::make_sphere(hand, R, 12, 24));
+    return sim::merge_meshes(sim::make_sphere(kHanger, kSphereR, 12, 24), sim::make_sphere(hand, kSphereR, 12, 24));
   };
   std::vector<Vec3> path = {Vec3(0.5, 0, 0), Vec3(0, 0, 0.025)};
   while (path.back().z() > -0.2) path.push_back(path.back() - Vec3(0, 0, 0.015));
