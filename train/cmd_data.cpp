@@ -65,7 +65,7 @@ struct MakeArgs {
       self_passes = -1;
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN,
          compression_exponent = NAN, self_slack = NAN;
-  double self_slack_per_pd = NAN, untangle_step = NAN, max_push_step = NAN;
+  double self_slack_per_pd = NAN, untangle_step = NAN, max_push_step = NAN, pinch_separation = NAN;
   double track_rate = NAN;  // 1/s: the HR simulation follows the LR one at the LR scale (sim/cloth_tracking.hpp)
   bool self_collision = true;
   bool limbs_pass_through = true;
@@ -200,6 +200,7 @@ void run_make(const MakeArgs& a) {
   if (!std::isnan(a.compression_exponent)) params.compression_pd_exponent = a.compression_exponent;
   if (!std::isnan(a.untangle_step)) params.untangle_step = a.untangle_step;
   if (!std::isnan(a.max_push_step)) params.max_push_step = a.max_push_step;
+  if (!std::isnan(a.pinch_separation)) params.pinch_separation = a.pinch_separation;
   params.track_rate = effective_track_rate(a);
   params.self_collision = a.self_collision;
   params.limbs_pass_through = a.limbs_pass_through;
@@ -254,6 +255,7 @@ void run_make(const MakeArgs& a) {
                   {"limbs_pass_through", params.limbs_pass_through},
                   {"limbs_pass_until_clear", params.limbs_pass_until_clear},
                   {"max_push_step_m", params.max_push_step},
+                  {"pinch_separation_m", params.pinch_separation},
                   {"self_thickness_m", params.self_thickness},
                   {"self_thickness_per_pd", params.self_thickness_per_pd},
                   {"self_slack_m", params.self_slack},
@@ -671,6 +673,10 @@ void add_data_command(CLI::App& app) {
           "metres per contact pass (one per iteration): how much farther than the body's surface a body contact "
           "moves cloth that hangs from no pin (default: the solver's; 1: at once, as before solver revision 15)")
       ->check(finite_range(1e-5, 1.0));
+  make->add_option("--pinch-separation", mk->pinch_separation,
+                   "metres: body points this far apart in the first pose are different parts, cloth pinched "
+                   "between them stays on the part it was dressed on (default: the solver's)")
+      ->check(finite_range(0.01, 1.0));
   make->add_option("--track-rate", mk->track_rate,
                    "1/s: HR follows the LR simulation at the LR scale, a difference in drape decaying at this rate, "
                    "and adds finer wrinkles (default: the solver's, 30; 0: independent, as before revision 13)")

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -219,8 +220,9 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
   const int steps = T + 2;  // the per-frame figures, then the LR and the HR self-intersections
   std::unique_ptr<BodyQuery> body;
   const Pairs lr_edges = unique_edges(d.lr.F), hr_edges = unique_edges(d.hr.F);
+  std::set<int> lr_torn, hr_torn;  // cloth vertices of edges longer than tear_stretch, over the clip
   for (int t = 0; t < T; ++t) {
-    auto strain = [&](const GarmentMesh& g, const Points3& X, ResolutionValidity& r) {
+    auto strain = [&](const GarmentMesh& g, const Points3& X, ResolutionValidity& r, std::set<int>& torn) {
       const StrainEnergies e = strain_energies(g, X);
       r.strain.E_u += e.E_u / T;
       r.strain.E_v += e.E_v / T;
@@ -228,15 +230,18 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
       r.strain.E_u_stretched += e.E_u_stretched / T;
       r.strain.E_v_stretched += e.E_v_stretched / T;
       const double stretch = max_edge_stretch(g, X);
-      r.torn_frames += stretch > opt.tear_stretch;
+      if (stretch > opt.tear_stretch) {
+        ++r.torn_frames;
+        for (int u : overstretched_vertices(g, X, opt.tear_stretch)) torn.insert(u);
+      }
       if (stretch > r.max_edge_stretch || r.max_edge_stretch_frame < 0) {
         r.max_edge_stretch = stretch;
         r.max_edge_stretch_frame = t;
       }
       r.mean_curvature += wrinkle_measure(X, g.F).mean_curvature / T;
     };
-    strain(d.lr, d.lr_frames[t], v.lr);
-    strain(d.hr, d.hr_frames[t], v.hr);
+    strain(d.lr, d.lr_frames[t], v.lr, lr_torn);
+    strain(d.hr, d.hr_frames[t], v.hr, hr_torn);
     const Points3 up = upsample(d.corr, d.lr_frames[t]);
     v.upsampled_mean_curvature += wrinkle_measure(up, d.hr.F).mean_curvature / T;
     const double agree = mean_distance(d.hr_frames[t], up);
@@ -274,6 +279,8 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
     }
     if (progress) progress(t + 1, steps);
   }
+  v.lr.torn_vertices = static_cast<int>(lr_torn.size());
+  v.hr.torn_vertices = static_cast<int>(hr_torn.size());
   measure_intersections(d.lr_frames, d.lr.F, opt.intersection_stride, v.lr, v.per_frame, &FrameValidity::lr_pairs);
   if (progress) progress(T + 1, steps);
   measure_intersections(d.hr_frames, d.hr.F, opt.intersection_stride, v.hr, v.per_frame, &FrameValidity::hr_pairs);
@@ -304,7 +311,8 @@ nlohmann::json resolution_json(const ResolutionValidity& r, bool body) {
                         {"E_v_stretched", r.strain.E_v_stretched},
                         {"max_edge_stretch", r.max_edge_stretch},
                         {"max_edge_stretch_frame", r.max_edge_stretch_frame},
-                        {"torn_frames", r.torn_frames}}},
+                        {"torn_frames", r.torn_frames},
+                        {"torn_vertices", r.torn_vertices}}},
                       {"mean_curvature_1_m", r.mean_curvature}};
   if (body)
     j["body"] = {{"max_penetration_m", r.max_penetration},
@@ -360,6 +368,7 @@ ResolutionValidity resolution_from_json(const nlohmann::json& j, bool body, cons
   } else {
     r.torn_frames = -1;
   }
+  r.torn_vertices = st.contains("torn_vertices") ? take<int>(st, "torn_vertices", where + "strain.") : -1;
   r.mean_curvature = take<double>(j, "mean_curvature_1_m", where);
   if (body) {
     const auto b = take<nlohmann::json>(j, "body", where);
@@ -484,6 +493,8 @@ std::string validity_table(const ValidityFigures& v) {
     char label[64];
     std::snprintf(label, sizeof label, "strain: frames with an edge > %gx", v.tear_stretch);
     line("  %-40s %14d %14d\n", label, v.lr.torn_frames, v.hr.torn_frames);
+    if (v.lr.torn_vertices >= 0 && v.hr.torn_vertices >= 0)
+      line("  %-40s %14d %14d\n", "  cloth vertices on those edges", v.lr.torn_vertices, v.hr.torn_vertices);
   }
   if (v.body_measured) {
     auto depth = [](const ResolutionValidity& r) {

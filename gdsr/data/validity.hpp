@@ -70,6 +70,8 @@ struct ResolutionValidity {
   double max_edge_stretch = 0;      // longest edge / pattern length, max over frames
   int max_edge_stretch_frame = -1;  // its frame
   int torn_frames = 0;              // frames with an edge longer than tear_stretch (-1: not measured)
+  int torn_vertices = 0;            // distinct cloth vertices at the ends of such edges over the clip (-1: not
+                                    // measured): a few when one spot is overstretched frame after frame
   // body (only when measured)
   double max_penetration = 0;      // metres, max over frames and vertices of -signed distance (0: none)
   int max_penetration_frame = -1;  // -1: no vertex penetrates in any frame

@@ -44,7 +44,7 @@ std::vector<std::string> failed_criteria(const ValidityFigures& v, const Validit
 std::string validity_summary_markdown(const std::vector<ValiditySummaryRow>& rows, const ValidityLimits& lim) {
   std::string s =
       "| dataset | garment | frames | clean LR / HR | E_u LR / HR | E_v LR / HR | E_uv LR / HR | "
-      "stretched fibres HR / LR: E_u, E_v | torn LR / HR | "
+      "stretched fibres HR / LR: E_u, E_v | torn LR / HR (their vertices) | "
       "inside, outside pinches: frames LR / HR, deepest mm | pinch frames LR / HR | threaded LR / HR | "
       "body crosses itself | agreement mm (drape / wrinkles) | HR curvature / upsampled LR | s/frame LR / HR | "
       "fails |\n"
@@ -59,6 +59,9 @@ std::string validity_summary_markdown(const std::vector<ValiditySummaryRow>& row
          format("%.4f / %.4f", L.strain.E_u, H.strain.E_u) + " | " + format("%.4f / %.4f", L.strain.E_v, H.strain.E_v) +
          " | " + format("%.4f / %.4f", L.strain.E_uv, H.strain.E_uv) + " | " + ratio_or_dash(v.stretched_ratio_u()) +
          ", " + ratio_or_dash(v.stretched_ratio_v()) + " | " + format("%.0f / %.0f", L.torn_frames, H.torn_frames) +
+         (L.torn_vertices >= 0 && H.torn_vertices >= 0
+              ? format(" (%.0f / %.0f vertices)", L.torn_vertices, H.torn_vertices)
+              : std::string()) +
          " | ";
     if (v.body_measured)
       s += format("%.0f / %.0f", L.frames_over_limit_free, H.frames_over_limit_free) +

@@ -60,20 +60,38 @@ StrainEnergies strain_energies(const GarmentMesh& g, const Points3& X) {
   return s;
 }
 
-double max_edge_stretch(const GarmentMesh& g, const Points3& X) {
+namespace {
+// Calls fn(i, j, length / pattern length) for each edge (i, j) of g's triangles that
+// strain_energies does not leave out (an edge shared by two triangles, twice).
+template <class Fn> void for_each_edge_stretch(const GarmentMesh& g, const Points3& X, Fn&& fn) {
   check_positions(g, X);
-  double worst = 0;
   for (int f = 0; f < g.F.rows(); ++f) {
     Eigen::Matrix2d Dm;
     if (degenerate_uv(g, f, Dm)) continue;
     for (int k = 0; k < 3; ++k) {
       const int a = (k + 1) % 3;
       const double rest = (g.UV.row(g.FUV(f, k)) - g.UV.row(g.FUV(f, a))).norm();  // > 0: not degenerate
-      worst = std::max(worst, (X.row(g.F(f, k)) - X.row(g.F(f, a))).norm() / rest);
+      fn(g.F(f, k), g.F(f, a), (X.row(g.F(f, k)) - X.row(g.F(f, a))).norm() / rest);
     }
   }
+}
+}  // namespace
+
+double max_edge_stretch(const GarmentMesh& g, const Points3& X) {
+  double worst = 0;
+  for_each_edge_stretch(g, X, [&](int, int, double r) { worst = std::max(worst, r); });
   // std::max drops a NaN ratio; a non-finite position must not read as intact cloth.
   return X.allFinite() ? worst : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::vector<int> overstretched_vertices(const GarmentMesh& g, const Points3& X, double limit) {
+  std::vector<int> out;
+  for_each_edge_stretch(g, X, [&](int i, int j, double r) {
+    if (!(r <= limit)) out.insert(out.end(), {i, j});  // a NaN counts as torn
+  });
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
 }
 
 }  // namespace gdsr

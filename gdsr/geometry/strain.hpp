@@ -10,6 +10,8 @@
 
 #include "gdsr/geometry/mesh.hpp"
 
+#include <vector>
+
 namespace gdsr {
 
 struct StrainEnergies {
@@ -30,5 +32,10 @@ StrainEnergies strain_energies(const GarmentMesh& g, const Points3& X);
 // E_u stayed below 0.01). Edges of the triangles strain_energies leaves out do not count; 0
 // for a garment without faces, NaN when a position is not finite.
 double max_edge_stretch(const GarmentMesh& g, const Points3& X);
+
+// The welded vertices at the ends of the edges max_edge_stretch counts that are longer than
+// `limit` times their pattern length, sorted, each once: whether a torn frame is cloth dragged
+// out of the garment here and there or one vertex overstretched again and again.
+std::vector<int> overstretched_vertices(const GarmentMesh& g, const Points3& X, double limit);
 
 }  // namespace gdsr

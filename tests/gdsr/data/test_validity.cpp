@@ -315,6 +315,8 @@ TEST_CASE("gdsr: validity counts the frames where a vertex is dragged out of the
   CHECK(v.hr.max_edge_stretch_frame == 2);
   CHECK(v.hr.torn_frames == 1);
   CHECK(v.lr.torn_frames == 0);
+  CHECK(v.hr.torn_vertices == 9);  // the dragged vertex and its eight neighbours (edges 3.0-4.15x)
+  CHECK(v.lr.torn_vertices == 0);
   // A higher threshold counts none; the table prints the figures.
   opt.tear_stretch = 5;
   CHECK(gdsr::measure_validity(d, opt).hr.torn_frames == 0);
@@ -323,19 +325,23 @@ TEST_CASE("gdsr: validity counts the frames where a vertex is dragged out of the
   const std::string table = gdsr::validity_table(v);
   CHECK(table.find("strain: frames with an edge > 2x") != std::string::npos);
   CHECK(table.find("4.15x (f  2)") != std::string::npos);
+  CHECK(table.find("cloth vertices on those edges") != std::string::npos);
   // Survives the manifest; a manifest written before the figure existed reads -1 (not measured)
   // and the table leaves the lines out.
   const nlohmann::json j = gdsr::validity_to_json(v);
   const gdsr::ValidityFigures back = gdsr::validity_from_json(j);
   CHECK(back.hr.torn_frames == 1);
+  CHECK(back.hr.torn_vertices == 9);
   CHECK(back.hr.max_edge_stretch == v.hr.max_edge_stretch);
   CHECK(back.tear_stretch == 2);
   nlohmann::json old = j;
   for (const char* res : {"lr", "hr"})
-    for (const char* k : {"max_edge_stretch", "max_edge_stretch_frame", "torn_frames"}) old[res]["strain"].erase(k);
+    for (const char* k : {"max_edge_stretch", "max_edge_stretch_frame", "torn_frames", "torn_vertices"})
+      old[res]["strain"].erase(k);
   old.erase("tear_stretch");
   const gdsr::ValidityFigures o = gdsr::validity_from_json(old);
   CHECK(o.hr.torn_frames == -1);
+  CHECK(o.hr.torn_vertices == -1);
   CHECK(gdsr::validity_table(o).find("frames with an edge") == std::string::npos);
 }
 

@@ -72,11 +72,13 @@ TEST_CASE("validity summary: a Markdown row per dataset with its figures and wha
   ok.v.lr.strain.E_u_stretched = 0.0004, ok.v.hr.strain.E_u_stretched = 0.0003;
   ok.v.lr.strain.E_v_stretched = 0.0005, ok.v.hr.strain.E_v_stretched = 0.0006;
   bad.v.lr.strain.E_u_stretched = bad.v.lr.strain.E_v_stretched = NAN;  // made before the split
+  ok.v.hr.torn_vertices = 3;  // the vertices on edges past the tear stretch; -1: made before they were counted
+  bad.v.hr.torn_vertices = -1;
   const std::string md = gdsr::validity_summary_markdown({ok, bad});
   CHECK(md.rfind("| dataset | garment | frames |", 0) == 0);
   CHECK(std::count(md.begin(), md.end(), '\n') == 4);  // header, separator, two rows
   CHECK(md.find("| clip_a | skirt_short | 10 | 100.0 / 100.0% | 0.0015 / 0.0015 |") != std::string::npos);
-  CHECK(md.find("| 0.0080 / 0.0080 | 0.75x, 1.20x | 0 / 0 |") != std::string::npos);
+  CHECK(md.find("| 0.0080 / 0.0080 | 0.75x, 1.20x | 0 / 0 (0 / 3 vertices) |") != std::string::npos);
   CHECK(md.find("| 0.0080 / 0.0080 | -, - | 0 / 0 |") != std::string::npos);
   CHECK(md.find("| 15.0 (0.0 / 0.0) | 1.11x | 0.05 / 0.50 | pass |") != std::string::npos);
   CHECK(md.find("| clip_b | tshirt | 10 | 100.0 / 50.0% |") != std::string::npos);

@@ -2,6 +2,7 @@
 // closed forms.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -71,6 +72,13 @@ TEST_CASE("strain: the longest edge over its pattern length finds one dragged-ou
   gdsr::Points3 d = g.V;
   d(inner, 2) += 3 * a;
   CHECK(gdsr::max_edge_stretch(g, d) == doctest::Approx(std::sqrt(10.0)).epsilon(1e-12));
+  // The vertices of the edges past 2x: the dragged vertex and its eight neighbours (the four
+  // quads around it are all split through it); past 3x, only the edges along u and v (3.16x).
+  const std::vector<int> torn = gdsr::overstretched_vertices(g, d, 2);
+  CHECK(torn.size() == 9);
+  CHECK(std::find(torn.begin(), torn.end(), inner) != torn.end());
+  CHECK(gdsr::overstretched_vertices(g, d, 3).size() == 5);
+  CHECK(gdsr::overstretched_vertices(g, s, 2).empty());
   d(inner, 0) = std::numeric_limits<double>::quiet_NaN();  // a NaN does not read as intact cloth
   CHECK(std::isnan(gdsr::max_edge_stretch(g, d)));
   CHECK_THROWS_WITH(gdsr::max_edge_stretch(g, s.topRows(3)), doctest::Contains("3 positions"));
