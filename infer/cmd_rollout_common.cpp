@@ -22,17 +22,21 @@ gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d) {
   gdsr::RolloutOptions opt = a.opt;
   opt.collisions = !a.no_collisions;
   opt.collision.sigma_b = gdsr::body_offset_for(d.manifest.sim_params, a.body_offset);
+  opt.collision.sigma_l = gdsr::layer_offset_for(d.manifest.sim_params, a.layer_offset);
   opt.collision.hr_planes = !a.lr_body_planes;
   gdsr::ProgressBar bar("roll-out");
   gdsr::RolloutResult r = gdsr::rollout(model, d, opt, bar.callback());
   bar.finish();
   int pushed = 0;
   for (const auto& c : r.collisions) pushed += c.hr_body + c.hr_layer;
+  char layers[64] = "";
+  if (d.manifest.layers > 1)
+    std::snprintf(layers, sizeof layers, ", layer offset %.1f mm", 1000 * opt.collision.sigma_l);
   std::printf(
       "rolled out %zu frames: %.3f s/frame (model %.3f s), LR %lld -> HR %lld vertices, %d HR vertices "
-      "moved by collision handling (body offset %.1f mm)\n",
+      "moved by collision handling (body offset %.1f mm%s)\n",
       r.G.size(), r.seconds_per_frame, r.model_seconds_per_frame, static_cast<long long>(d.lr.V.rows()),
-      static_cast<long long>(d.hr.V.rows()), pushed, 1000 * opt.collision.sigma_b);
+      static_cast<long long>(d.hr.V.rows()), pushed, 1000 * opt.collision.sigma_b, layers);
   std::printf("  model parts: correction E moves LR vertices %.2f mm, detail A moves HR vertices %.2f mm (mean)\n",
               1000 * r.mean_correction, 1000 * r.mean_detail);
   return r;
@@ -118,6 +122,10 @@ void add_rollout_options(CLI::App* c, RolloutArgs& a, bool data_required) {
   c->add_option("--body-offset", a.body_offset,
                 "metres the collision handling keeps the HR garment off the body (default: the dataset's simulation "
                 "thickness, else the paper's 0.015)")
+      ->check(CLI::Range(0.0, 0.1));
+  c->add_option("--layer-offset", a.layer_offset,
+                "metres the collision handling keeps an outer layer off the layer under it (default: the dataset's "
+                "simulation layer gap, else the paper's 0.020)")
       ->check(CLI::Range(0.0, 0.1));
   c->add_flag("--lr-body-planes", a.lr_body_planes,
               "collision handling as in the paper: HR vertices pushed out of the tangent plane of their nearest LR "

@@ -84,6 +84,16 @@ double body_offset_for(const nlohmann::json& sim_params, double given) {
   return CollisionConfig{}.sigma_b;
 }
 
+double layer_offset_for(const nlohmann::json& sim_params, double given) {
+  if (given >= 0) return given;
+  for (const char* key : {"layer_gap_m", "thickness_m"}) {
+    const auto it = sim_params.find(key);
+    if (it != sim_params.end() && it->is_number() && it->get<double>() > 0 && it->get<double>() < 0.1)
+      return it->get<double>();
+  }
+  return CollisionConfig{}.sigma_l;
+}
+
 BodyQueryFn body_query_fn(const BodyQuery& body) {
   return [&body](const Points3& q, Points3& closest, Points3& normal) {
     ClosestPoints c = body.closest(q, true);

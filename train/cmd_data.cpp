@@ -240,6 +240,7 @@ void run_make(const MakeArgs& a) {
                   {"iterations", params.iterations},
                   {"stretch_passes", params.stretch_passes},
                   {"thickness_m", params.thickness},
+                  {"layer_gap_m", params.layer_gap},
                   {"friction", params.friction},
                   {"density_kg_m2", params.density},
                   {"stretch_stiffness_n_m", params.stretch_stiffness},

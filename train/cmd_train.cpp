@@ -68,6 +68,7 @@ void run_train(TrainArgs& a, const gdsr::MpiRanks& mpi) {
   std::vector<const gdsr::Dataset*> ptrs;
   for (const auto& s : sets) ptrs.push_back(&s);
   for (const auto& s : val_sets) a.opt.validation.push_back(&s);
+  gdsr::check_init_weights(a.opt);  // weights of another preset are refused before the run folder is made
   const std::filesystem::path out(a.out);
   if (writer) {
     std::filesystem::create_directories(a.out);
@@ -156,6 +157,9 @@ void add_train_command(CLI::App& app) {
   c->add_option("--seed", a->opt.seed, "frame order, patches, noise")->capture_default_str();
   c->add_option("--checkpoint-every", a->opt.checkpoint_every, "steps between checkpoints")->capture_default_str();
   c->add_option("--resume", a->opt.resume, "continue a run exactly from its checkpoint (e.g. OUT/model.ckpt)");
+  c->add_option("--init", a->opt.init,
+                "start from this model's weights (a checkpoint of the same preset, e.g. models/*.ckpt): "
+                "fine-tuning, fresh optimizer, step 0");
   c->add_option("--patches", a->opt.patches.count, "UV patches per step")->capture_default_str();
   c->add_option("--patch-size", a->opt.patches.size, "patch side in raster pixels")->capture_default_str();
   c->add_option("--log-every", a->log_every, "print a loss line every N steps")->capture_default_str();

@@ -39,6 +39,7 @@ nlohmann::json train_options_to_json(const TrainOptions& o) {
   j["best_checkpoint"] = o.best_checkpoint;
   j["validation_datasets"] = o.validation.size();
   j["resume"] = o.resume;
+  j["init"] = o.init;
   return j;
 }
 

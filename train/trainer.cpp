@@ -112,7 +112,7 @@ void restore_progress(TrainState& s, const nn::Checkpoint& ck, const std::string
   s.noise.set_state(s.p.noise);
 }
 
-// Sequences, model, AdamW (resumed from opt.resume), VGG, the step range and the RNGs.
+// Sequences, model (from opt.init's weights), AdamW (resumed from opt.resume), VGG, the step range and the RNGs.
 void start_training(TrainState& s, const std::vector<const Dataset*>& data, const TrainOptions& opt) {
   for (const Dataset* d : data) {
     s.seqs.push_back(prepare(*d, opt));
@@ -133,6 +133,7 @@ void start_training(TrainState& s, const std::vector<const Dataset*>& data, cons
                        std::to_string(d->hr.V.rows()) + " " + std::to_string(d->lr_frames.size()));
   s.rng.seed(opt.seed);
   s.noise = nn::Rng(opt.seed * 7919 + 1);
+  if (!opt.init.empty()) nn::load_checkpoint(opt.init, *s.model, static_cast<nn::AdamW<float>*>(nullptr));
   if (!opt.resume.empty()) {
     const nn::Checkpoint ck = nn::load_checkpoint(opt.resume, *s.model, s.adam.get());
     restore_progress(s, ck, opt.resume, opt);
@@ -490,6 +491,12 @@ void write_checkpoints(TrainState& s, bool best, const TrainOptions& opt) {
 
 }  // namespace
 
+void check_init_weights(const TrainOptions& opt) {
+  if (opt.init.empty()) return;
+  GDSR<float> probe(opt.model);
+  nn::load_checkpoint(opt.init, probe, static_cast<nn::AdamW<float>*>(nullptr));
+}
+
 void validate_train_options(const TrainOptions& opt) {
   if (opt.epochs <= 0) gdsr::fail("train", "--epochs must be positive, got " + std::to_string(opt.epochs));
   if (opt.max_steps == 0 || opt.max_steps < -1)
@@ -499,6 +506,8 @@ void validate_train_options(const TrainOptions& opt) {
   if (opt.ranks > 1 && !opt.allreduce_sum) gdsr::fail("train", "several ranks need an all-reduce");
   if (opt.frames_per_step <= 0)
     gdsr::fail("train", "--frames-per-step must be positive, got " + std::to_string(opt.frames_per_step));
+  if (!opt.init.empty() && !opt.resume.empty())
+    gdsr::fail("train", "--init starts a new run from a model's weights and --resume continues one: give one");
   if (opt.rollout_history < 0 || opt.rollout_history > 64)
     gdsr::fail("train", "--rollout-history must be 0 (teacher forcing) to 64 frames, got " +
                             std::to_string(opt.rollout_history));

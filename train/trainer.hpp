@@ -62,6 +62,9 @@ struct TrainOptions {
   std::string best_checkpoint;
   std::vector<const Dataset*> validation;  // scored (no gradient) at every checkpoint
   std::string resume;  // continue from this checkpoint (model, AdamW, data order, RNGs)
+  // Start from this model's weights (any checkpoint of the same preset, e.g. a `gdsr weights`
+  // file): fine-tuning, with a fresh AdamW and step 0. Not with resume.
+  std::string init;
   // Data-parallel training (train/mpi_ranks.hpp): this process is rank `rank` of `ranks`;
   // a step covers frames_per_step frames on every rank, `allreduce_sum` sums a buffer over
   // all ranks in place (needed when ranks > 1). Give checkpoint paths on one rank only.
@@ -73,6 +76,10 @@ struct TrainOptions {
 // max_steps, frames_per_step, lr, weight decay, schedule, loss weights, patches).
 // train_gdsr calls it first, so nothing is written for bad options.
 void validate_train_options(const TrainOptions& opt);
+
+// Throws a one-line gdsr::Error naming opt.init when its weights do not fit opt.model (another
+// preset, a missing or corrupt file). Reads the file; run it before the run folder is made.
+void check_init_weights(const TrainOptions& opt);
 
 struct TrainLog {
   int64_t step = 0, total_steps = 0;

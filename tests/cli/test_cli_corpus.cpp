@@ -303,6 +303,8 @@ std::vector<Case> corpus() {
       {kInfer + "{d}/ds --first 2 --frames 9", "--frames"},
       {kInfer + "{d}/ds --obj-every -1", "--obj-every"},
       {kInfer + "{d}/ds --ablate everything", "--ablate"},
+      {kInfer + "{d}/ds --layer-offset -0.01", "--layer-offset"},
+      {kInfer + "{d}/ds --layer-offset 0.5", "--layer-offset"},
       {kInfer + "{d}/missing", "missing"},
       {kInfer + "{d}/ds --lr-dir {d}/exp_md/lr", "--lr-dir"},
       {"infer --model {d}/run/model.ckpt --out {d}/pred", "--data"},

@@ -253,6 +253,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"hr_track_rate_1_s\": 4") != std::string::npos);
   CHECK(manifest.find("\"max_push_step_m\": 0.01") != std::string::npos);
   CHECK(manifest.find("\"pinch_separation_m\": 0.08") != std::string::npos);
+  CHECK(manifest.find("\"layer_gap_m\": 0.004") != std::string::npos);  // the infer layer offset's default
   for (const std::string bad :
        {"--iterations 0", "--friction -1", "--self-thickness 1", "--bend-stiffness -2", "--compression-ratio 0",
         "--compression-exponent -1", "--compression-exponent 5", "--settle-frames -1", "--contact-every 0",

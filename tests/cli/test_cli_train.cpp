@@ -245,3 +245,49 @@ TEST_CASE("cli weights: a run's weights alone load in infer with the same predic
   CHECK(resumed.status != 0);
   check_one_line_error(resumed, "w.ckpt");
 }
+
+TEST_CASE("cli train: --init fine-tunes from a model's weights with a fresh optimizer from step 0") {
+  TempDir dir("cli_train_init");
+  const std::string data = dir / "wave";
+  gdsr::write_dataset(data, gdsr_test::wave_dataset());
+  const std::string tiny = std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json";
+  const std::string base = "train --data '" + data + "' --config '" + tiny + "' --no-vgg --patches 2 --patch-size 32 ";
+  REQUIRE(gdsr_run(dir, base + "--max-steps 6 --lr 3e-3 --out '" + (dir / "first") + "'").status == 0);
+  const std::string weights = "weights --model '" + (dir / "first/model.ckpt") + "' --out '" + (dir / "w.ckpt") + "'";
+  REQUIRE(gdsr_run(dir, weights).status == 0);
+  // Two steps at the smallest learning rate (the schedule's floor, 1e-6) move no weight by more
+  // than ~2e-6 (AdamW's first steps are at most ~lr each): the fine-tuned run ends where its init
+  // was, while the same two steps from a fresh model's random weights end ~0.1 away.
+  const std::string tiny_steps = base + "--max-steps 2 --lr 1e-6 --out '";
+  const Run tuned = gdsr_run(dir, tiny_steps + (dir / "tuned") + "' --init '" + (dir / "w.ckpt") + "'");
+  REQUIRE(tuned.status == 0);
+  CHECK(tuned.out.find("trained 2 steps") != std::string::npos);  // a new run: step 0, not the init's 6
+  REQUIRE(gdsr_run(dir, tiny_steps + (dir / "fresh") + "'").status == 0);
+  const nn::Checkpoint w = nn::read_checkpoint(dir / "w.ckpt");
+  auto largest_difference = [&](const std::string& ckpt) {
+    const nn::Checkpoint t = nn::read_checkpoint(ckpt);
+    CHECK(t.step == 2);
+    double largest = 0;
+    for (const auto& e : w.entries) {
+      REQUIRE(t.find(e.name));
+      const std::vector<float> a = w.read<float>(e.name), b = t.read<float>(e.name);
+      REQUIRE(a.size() == b.size());
+      for (size_t i = 0; i < a.size(); ++i) largest = std::max(largest, static_cast<double>(std::abs(a[i] - b[i])));
+    }
+    return largest;
+  };
+  CHECK(largest_difference(dir / "tuned/model.ckpt") < 5e-6);
+  CHECK(largest_difference(dir / "fresh/model.ckpt") > 1e-2);
+  CHECK(nlohmann::json::parse(slurp(dir / "tuned/config.json")).at("init") == dir / "w.ckpt");
+  // With --resume, or weights of another preset: a one-line error naming the problem.
+  check_one_line_error(gdsr_run(dir, base + "--init '" + (dir / "w.ckpt") + "' --resume '" +
+                                         (dir / "first/model.ckpt") + "' --out '" + (dir / "both") + "'"),
+                       "--init");
+  const std::string small = std::string(GDSR_SOURCE_DIR) + "/configs/small.json";
+  check_one_line_error(gdsr_run(dir, "train --data '" + data + "' --config '" + small + "' --no-vgg --init '" +
+                                         (dir / "w.ckpt") + "' --out '" + (dir / "other") + "'"),
+                       "w.ckpt");
+  check_one_line_error(gdsr_run(dir, base + "--init '" + (dir / "none.ckpt") + "' --out '" + (dir / "none") + "'"),
+                       "none.ckpt");
+  CHECK_FALSE(fs::exists(dir / "other"));
+}

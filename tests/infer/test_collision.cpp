@@ -231,3 +231,15 @@ TEST_CASE("collision: the body offset is the flag, else the dataset's simulation
   CHECK(gdsr::body_offset_for({{"thickness_m", "4 mm"}}, -1) == 0.015);  // not a number: ignored
   CHECK(gdsr::body_offset_for({{"thickness_m", 2.0}}, -1) == 0.015);     // 2 m is not a thickness
 }
+
+TEST_CASE("collision: the layer offset is the flag, else the dataset's layer gap, else the paper's") {
+  const nlohmann::json sim = {{"thickness_m", 0.004}, {"layer_gap_m", 0.003}};
+  CHECK(gdsr::layer_offset_for(sim, -1) == 0.003);
+  CHECK(gdsr::layer_offset_for(sim, 0.01) == 0.01);
+  CHECK(gdsr::layer_offset_for(sim, 0) == 0.0);
+  // Our solver's data from before the layer gap was recorded: its thickness, the same 4 mm.
+  CHECK(gdsr::layer_offset_for({{"thickness_m", 0.004}}, -1) == 0.004);
+  CHECK(gdsr::layer_offset_for(nlohmann::json::object(), -1) == 0.020);  // imported data: the paper's
+  CHECK(gdsr::layer_offset_for({{"layer_gap_m", "4 mm"}, {"thickness_m", 0.005}}, -1) == 0.005);  // not a number
+  CHECK(gdsr::layer_offset_for({{"layer_gap_m", 2.0}}, -1) == 0.020);                             // 2 m is not a gap
+}
