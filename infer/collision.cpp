@@ -8,6 +8,7 @@
 #include <nanoflann.hpp>
 
 #include <algorithm>
+#include <initializer_list>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -74,24 +75,27 @@ int push_own_planes(const std::vector<int>& rows, const BodyQueryFn& body, doubl
   return moved;
 }
 
-}  // namespace
-
-double body_offset_for(const nlohmann::json& sim_params, double given) {
-  if (given >= 0) return given;
-  const auto it = sim_params.find("thickness_m");
-  if (it != sim_params.end() && it->is_number() && it->get<double>() > 0 && it->get<double>() < 0.1)
-    return it->get<double>();
-  return CollisionConfig{}.sigma_b;
-}
-
-double layer_offset_for(const nlohmann::json& sim_params, double given) {
-  if (given >= 0) return given;
-  for (const char* key : {"layer_gap_m", "thickness_m"}) {
+// The first of `keys` in sim_params that holds a plausible offset (a number of metres in
+// (0, 0.1)), else `fallback`.
+double offset_from(const nlohmann::json& sim_params, std::initializer_list<const char*> keys, double fallback) {
+  for (const char* key : keys) {
     const auto it = sim_params.find(key);
     if (it != sim_params.end() && it->is_number() && it->get<double>() > 0 && it->get<double>() < 0.1)
       return it->get<double>();
   }
-  return CollisionConfig{}.sigma_l;
+  return fallback;
+}
+
+}  // namespace
+
+double body_offset_for(const nlohmann::json& sim_params, double given) {
+  if (given >= 0) return given;
+  return offset_from(sim_params, {"thickness_m"}, CollisionConfig{}.sigma_b);
+}
+
+double layer_offset_for(const nlohmann::json& sim_params, double given) {
+  if (given >= 0) return given;
+  return offset_from(sim_params, {"layer_gap_m", "thickness_m"}, CollisionConfig{}.sigma_l);
 }
 
 BodyQueryFn body_query_fn(const BodyQuery& body) {
