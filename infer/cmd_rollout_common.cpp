@@ -23,7 +23,7 @@ gdsr::RolloutResult run_rollout(const RolloutArgs& a, const gdsr::Dataset& d) {
   opt.collisions = !a.no_collisions;
   opt.collision.sigma_b = gdsr::body_offset_for(d.manifest.sim_params, a.body_offset);
   opt.collision.sigma_l = gdsr::layer_offset_for(d.manifest.sim_params, a.layer_offset);
-  opt.collision.hr_planes = !a.lr_body_planes;
+  opt.collision.hr_planes = !a.lr_planes;
   gdsr::ProgressBar bar("roll-out");
   gdsr::RolloutResult r = gdsr::rollout(model, d, opt, bar.callback());
   bar.finish();
@@ -127,9 +127,10 @@ void add_rollout_options(CLI::App* c, RolloutArgs& a, bool data_required) {
                 "metres the collision handling keeps an outer layer off the layer under it (default: the dataset's "
                 "simulation layer gap, else the paper's 0.020)")
       ->check(CLI::Range(0.0, 0.1));
-  c->add_flag("--lr-body-planes", a.lr_body_planes,
-              "collision handling as in the paper: HR vertices pushed out of the tangent plane of their nearest LR "
-              "vertex's body point (default: each its own, exact on a curved body)");
+  c->add_flag("--lr-planes,--lr-body-planes", a.lr_planes,
+              "collision handling as in the paper: HR vertices pushed out of the tangent plane at their nearest LR "
+              "vertex's body point or inner-layer vertex (default: each its own closest point, exact on a curved "
+              "body or layer)");
   c->add_option("--ablate", a.ablate,
                 "switch a part of the model off (repeatable): correction (C^ = C, no E) or detail (G = upsampled "
                 "C^, no A)")

@@ -20,7 +20,7 @@ struct RolloutArgs {
   std::string model, data, out = "runs/infer", pred;
   gdsr::RolloutOptions opt;
   bool no_collisions = false;
-  bool lr_body_planes = false;  // the paper's body pass: HR vertices pushed out of their LR vertex's plane
+  bool lr_planes = false;       // the paper's collision passes: HR vertices pushed out of their LR vertex's plane
   double layer_offset = -1;     // m, layer pass of the collision post-process; < 0: from the dataset (see run_rollout)
   double body_offset = -1;  // m, body pass of the collision post-process; < 0: from the dataset (see run_rollout)
   std::vector<std::string> ablate;  // parts of the model switched off: "correction", "detail"

@@ -75,6 +75,50 @@ int push_own_planes(const std::vector<int>& rows, const BodyQueryFn& body, doubl
   return moved;
 }
 
+// The LR garment's faces of the layers below L (all three vertices of layer < L), with only
+// the vertices they use.
+TriMesh inner_layers(const Points3& C, const Faces& F, const std::vector<int>& layer, int L) {
+  std::vector<int> index(C.rows(), -1), rows, faces;
+  for (int f = 0; f < F.rows(); ++f) {
+    if (layer[F(f, 0)] >= L || layer[F(f, 1)] >= L || layer[F(f, 2)] >= L) continue;
+    faces.push_back(f);
+    for (int c = 0; c < 3; ++c)
+      if (index[F(f, c)] < 0) {
+        index[F(f, c)] = static_cast<int>(rows.size());
+        rows.push_back(F(f, c));
+      }
+  }
+  TriMesh m;
+  m.V.resize(static_cast<Eigen::Index>(rows.size()), 3);
+  for (size_t r = 0; r < rows.size(); ++r) m.V.row(static_cast<Eigen::Index>(r)) = C.row(rows[r]);
+  m.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  for (size_t k = 0; k < faces.size(); ++k)
+    for (int c = 0; c < 3; ++c) m.F(static_cast<Eigen::Index>(k), c) = index[F(faces[k], c)];
+  return m;
+}
+
+// Moves each HR vertex in `rows` out of the tangent plane of its own closest point on the
+// inner layers (smooth normal) to offset sigma_l. Skipped: vertices farther than gamma from
+// them, and vertices beside the inner layers' open edge rather than over them (offset along
+// the surface above sigma_l), which a plane at the edge would drag sideways. Returns the
+// moved count.
+int push_over_layer(const std::vector<int>& rows, const TriMesh& inner, const CollisionConfig& cfg, Points3& G) {
+  if (inner.F.rows() == 0) return 0;
+  Points3 q(static_cast<Eigen::Index>(rows.size()), 3);
+  for (size_t k = 0; k < rows.size(); ++k) q.row(static_cast<Eigen::Index>(k)) = G.row(rows[k]);
+  const ClosestPoints c = BodyQuery(inner).closest(q, true, cfg.gamma);
+  int moved = 0;
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const Eigen::Index r = static_cast<Eigen::Index>(k);
+    if (c.face(r) < 0) continue;
+    const Vec3 p = c.point.row(r).transpose(), n = c.normal.row(r).transpose();
+    const Vec3 d = q.row(r).transpose() - p;
+    if ((d - d.dot(n) * n).norm() > cfg.sigma_l) continue;
+    moved += push_out_of_plane(rows[k], p, n, cfg.sigma_l, G);
+  }
+  return moved;
+}
+
 // The first of `keys` in sim_params that holds a plausible offset (a number of metres in
 // (0, 0.1)), else `fallback`.
 double offset_from(const nlohmann::json& sim_params, std::initializer_list<const char*> keys, double fallback) {
@@ -160,6 +204,7 @@ CollisionStats resolve_collisions(const CollisionConfig& cfg, const CollisionInp
         if (layer[i] < L) cloud.rows.push_back(i);
       if (cloud.rows.empty()) continue;
       SubsetTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+      std::vector<int> candidates;  // HR vertices of colliding LR vertices of layer L (hr_planes)
       for (int e = 0; e < nl; ++e) {
         if (layer[e] != L) continue;
         uint32_t idx = 0;
@@ -170,9 +215,15 @@ CollisionStats resolve_collisions(const CollisionConfig& cfg, const CollisionInp
         const Vec3 ci = C.row(i).transpose(), ni = N.row(i).transpose();
         if (d2 < cfg.gamma * cfg.gamma && cfg.sigma_l - (C.row(e).transpose() - ci).dot(ni) > 0) {
           ++st.lr_layer;
-          st.hr_layer += push_group(groups, e, ci, ni, cfg.sigma_l, G);
+          if (cfg.hr_planes)
+            candidates.insert(candidates.end(), groups.items.begin() + groups.offsets[e],
+                              groups.items.begin() + groups.offsets[e + 1]);
+          else
+            st.hr_layer += push_group(groups, e, ci, ni, cfg.sigma_l, G);
         }
       }
+      if (!candidates.empty()) st.hr_layer += push_over_layer(candidates, inner_layers(C, *in.lr_F, layer, L), cfg, G);
+      st.hr_layer_queried += static_cast<int>(candidates.size());
     }
   }
   return st;

@@ -16,7 +16,11 @@
 //   paired with its nearest LR vertex i of the layers below (layer < L); it collides when
 //   sigma_l - (c^_e - c^_i) . n_i > 0 and |c^_e - c^_i| < gamma (n_i: area-weighted vertex
 //   normal of C^). HR vertices whose nearest LR vertex is a colliding e move to
-//   g_k + max(sigma_l - (g_k - c^_i) . n_i, 0) n_i. Applied after the body pass.
+//   g_k + max(sigma_l - (g_k - c^_i) . n_i, 0) n_i in the paper (hr_planes off). By default
+//   each of them gets its own closest point p_k on the LR faces of the layers below and the
+//   smooth normal n_k there, and moves to g_k + max(sigma_l - (g_k - p_k) . n_k, 0) n_k, when
+//   p_k is within gamma and g_k lies over that surface, not beside its open edge. Applied
+//   after the body pass.
 // gamma default 0.04 m: a vertex lying within sigma_l of the interior sheet has its nearest
 //   interior LR vertex within about sqrt(0.02^2 + (0.03/sqrt 2)^2) ~ 0.029 m at the
 //   reference's 30 mm LR spacing; 0.04 m keeps that with margin while ignoring vertices
@@ -35,7 +39,8 @@ namespace gdsr {
 struct CollisionConfig {
   bool body = true;
   double sigma_b = 0.015;  // metres
-  bool hr_planes = true;   // push HR vertices out of their own tangent planes (false: the LR vertex's, the paper's)
+  bool hr_planes = true;   // push HR vertices out of their own tangent planes of the body and of the
+                           // layer under them (false: the LR vertex's planes, the paper's)
   bool layers = true;
   double sigma_l = 0.020;  // metres
   double gamma = 0.04;     // metres
@@ -72,6 +77,7 @@ struct CollisionStats {
   int hr_queried = 0;  // HR vertices given their own body query (hr_planes: those of colliding LR vertices)
   int lr_layer = 0;  // exterior LR vertices colliding with an interior layer
   int hr_layer = 0;  // HR vertices moved by the layer pass
+  int hr_layer_queried = 0;  // HR vertices given their own closest point on the layers below (hr_planes)
   bool body_queried = false;
   bool layers_checked = false;
 };

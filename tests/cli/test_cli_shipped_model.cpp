@@ -45,7 +45,7 @@ TEST_CASE("cli shipped model: on an unseen motion it beats the upsampled LR, sta
   // The paper's body pass (each HR vertex pushed out of its LR vertex's tangent plane) moves
   // more HR vertices than the default, each out of its own plane.
   const gdsr_test::Run paper = gdsr_run(dir, "infer --model '" + model + "' --data '" + (dir / "ds") +
-                                                 "' --lr-body-planes --out '" + (dir / "pred_paper") + "'");
+                                                 "' --lr-planes --out '" + (dir / "pred_paper") + "'");
   REQUIRE(paper.status == 0);
   const auto moved = [](const std::string& out) {
     const size_t at = out.find(" HR vertices moved by collision handling");

@@ -222,6 +222,62 @@ TEST_CASE("collision: on a curved body each HR vertex leaves its own tangent pla
   CHECK(G(0, 0) == G0(0, 0));
 }
 
+TEST_CASE("collision: on a curved inner layer each HR vertex leaves its own tangent plane, and none beside its edge") {
+  // Inner layer (0): an open cylinder of radius R about the z axis, 64 segments, z in [0, 0.1],
+  // normals outwards. Exterior LR vertex e (layer 1) 2 mm outside it at angle 0: it collides.
+  // Its HR vertices, at segment 4's angle a (a mesh vertex, whose smooth normal is radial):
+  // 0 lies 1 mm beyond sigma_l (stays), 1 lies 2 mm out (pushed radially to sigma_l); 2 lies
+  // 3 cm below the layer's open edge (beside it, not over it: stays). The paper's rule pushes
+  // all three to the LR vertex's plane x = R + sigma_l.
+  const double R = 0.1, sigma = 0.02, a = 4 * 2 * M_PI / 64;
+  const int seg = 64, rings = 5;
+  const int ni = seg * rings, e = ni;
+  Points3 C(ni + 1, 3);
+  for (int j = 0; j < rings; ++j)
+    for (int s = 0; s < seg; ++s)
+      C.row(j * seg + s) << R * std::cos(2 * M_PI * s / seg), R * std::sin(2 * M_PI * s / seg), 0.025 * j;
+  C.row(e) << R + 0.002, 0, 0.05;
+  Faces F(2 * seg * (rings - 1), 3);
+  for (int j = 0, f = 0; j + 1 < rings; ++j)
+    for (int s = 0; s < seg; ++s) {
+      const int v00 = j * seg + s, v01 = j * seg + (s + 1) % seg, v11 = v01 + seg, v10 = v00 + seg;
+      F.row(f++) << v00, v01, v11;
+      F.row(f++) << v00, v11, v10;
+    }
+  std::vector<int> layer(ni + 1, 0);
+  layer[e] = 1;
+  Points3 G(3, 3);
+  G << (R + sigma + 0.001) * std::cos(a), (R + sigma + 0.001) * std::sin(a), 0.05,  //
+      (R + 0.002) * std::cos(a), (R + 0.002) * std::sin(a), 0.05,                   //
+      R, 0, -0.03;
+  const Points3 G0 = G;
+  const std::vector<int> nearest = {e, e, e};
+  CollisionInput in;
+  in.C_hat = &C;
+  in.lr_F = &F;
+  in.lr_layer = &layer;
+  in.hr_nearest_lr = &nearest;
+  CollisionConfig cfg;
+  cfg.sigma_l = sigma;
+  CollisionStats st = resolve_collisions(cfg, in, G);
+  CHECK(st.lr_layer == 1);
+  CHECK(st.hr_layer_queried == 3);
+  CHECK(st.hr_layer == 1);
+  CHECK(G.row(0) == G0.row(0));
+  CHECK(G.row(1).head<2>().norm() == doctest::Approx(R + sigma).epsilon(1e-12));
+  CHECK(G(1, 1) / G(1, 0) == doctest::Approx(std::tan(a)).epsilon(1e-12));  // radially
+  CHECK(G(1, 2) == doctest::Approx(0.05).epsilon(1e-12));
+  CHECK(G.row(2) == G0.row(2));
+  // The paper's rule: every HR vertex of e up to the plane of e's nearest inner vertex.
+  G = G0;
+  cfg.hr_planes = false;
+  st = resolve_collisions(cfg, in, G);
+  CHECK(st.hr_layer == 3);
+  CHECK(st.hr_layer_queried == 0);
+  for (int k = 0; k < 3; ++k) CHECK(G(k, 0) == doctest::Approx(R + sigma).epsilon(1e-12));
+  CHECK(G(0, 0) - G0(0, 0) > 0.008);  // (R + sigma) - (R + sigma + 1 mm) cos a = 8.2 mm
+}
+
 TEST_CASE("collision: the body offset is the flag, else the dataset's simulation thickness, else the paper's") {
   nlohmann::json sim = {{"thickness_m", 0.004}};
   CHECK(gdsr::body_offset_for(sim, -1) == 0.004);
