@@ -3,6 +3,8 @@
 // triangle mesh, never the solver's own collision code.
 #include <doctest/doctest.h>
 
+#include <utility>
+
 #include "tests/support/cloth_bodies.hpp"
 #include "tests/support/square_cloth.hpp"
 #include "gdsr/sim/cloth_self_collision.hpp"
@@ -73,8 +75,9 @@ struct TwoSheetDrop {
   sim::Garment g;
   sim::SimParams p;
   std::unique_ptr<sim::ClothSolver> solver;
-  explicit TwoSheetDrop(double h) : g(two_sheets(h, nl)) {
+  explicit TwoSheetDrop(double h, double self_thickness = -1) : g(two_sheets(h, nl)) {
     p.settle_frames = 0;
+    if (self_thickness > 0) p.self_thickness = self_thickness;
     solver = std::make_unique<sim::ClothSolver>(g, gdsr::Faces(), Points3(), p);
   }
 };
@@ -259,7 +262,9 @@ TEST_CASE("self-collision: a sheet dropped onto a clamped sheet lands on it at b
     // padding, so detection runs more often than every self_detect_every substeps (free fall
     // follows the prediction exactly, so the slack alone would not trigger it).
     CAPTURE(fall_detections);
-    CHECK(fall_detections > 7 * p.substeps / p.self_detect_every * 6 / 5);  // 35 without; 43 (30 mm), 48 (15 mm) with
+    // Detections every self_detect_every substeps alone, in effect (4 at 30 mm, 5 at 15 mm, see
+    // SimParams::self_slack_per_pd): 35 (30 mm), 28 (15 mm); measured 43 and 40.
+    CHECK(fall_detections > 7 * p.substeps / solver.params().self_detect_every * 6 / 5);
     // Every upper vertex above the lower sheet stays above it (the sheet sags only a little).
     const auto& X = solver.positions();
     double lower_max = -1e9;
@@ -328,9 +333,11 @@ TEST_CASE("self-collision: a vertex found beyond its reach on the wrong side is 
 TEST_CASE("self-collision: resting layers are kept the larger of the thickness and a sixth of the particle distance apart") {
   // The dropped sheet of the test above, 1.5 s later at rest on the clamped one: the gap from
   // each upper vertex over the middle to the nearest lower triangle (brute force), median.
-  for (double h : {0.03, 0.015}) {
+  // (particle distance, thickness): a sixth of 30 mm over a 3 mm thickness; the default 5 mm over a sixth of 15 mm.
+  for (const auto& [h, thickness] : {std::pair{0.03, 0.003}, std::pair{0.015, -1.0}}) {
     CAPTURE(h);
-    TwoSheetDrop d(h);
+    CAPTURE(thickness);
+    TwoSheetDrop d(h, thickness);
     const int nl = d.nl;
     for (int t = 0; t < 45; ++t) d.solver->step(Points3(), Points3(), 1.0 / 30);
     const auto& X = d.solver->positions();
@@ -351,7 +358,7 @@ TEST_CASE("self-collision: resting layers are kept the larger of the thickness a
     }
     REQUIRE(gaps.size() > 5);
     std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
-    const double want = std::max(p.self_thickness, h * p.self_thickness_per_pd);  // 5 mm at 30 mm, 3 mm at 15 mm
+    const double want = std::max(p.self_thickness, h * p.self_thickness_per_pd);
     CAPTURE(want);
     CHECK(gaps[gaps.size() / 2] == doctest::Approx(want).epsilon(0.1));
   }
