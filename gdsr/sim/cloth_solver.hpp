@@ -114,8 +114,10 @@ namespace sim {
 //     (SimParams::self_thickness), as at 30 mm: at 10 mm it was 3 mm, so HR folds could close
 //     tighter than LR ones, and a fold collapsed over one face row behind a bent knee or in a
 //     salsa turn went through itself. HR frames free of self-intersections (CGAL), revision 17
-//     -> 18, 4 s clips: pants on walk 131_02 84.6 -> 100%, skirt_short on salsa 61_03 91.9 ->
-//     100%. Meshes of 30 mm and coarser are unchanged, bit for bit.
+//     -> 18, 4 s clips: pants on walk 131_02 84.6 -> 100%, on salsa 60_02 95.6 -> 100%, on salsa
+//     61_03 63.2 -> 100%; skirt_short on salsa 61_03 91.9 -> 100%, on CMU 01_01 98.5 -> 100%;
+//     skirt_pleated on salsa 61_03 94.1 -> 100%. The HR solver takes ~20% more CPU time (skirt_short,
+//     bench_cloth). Meshes of 30 mm and coarser are unchanged, bit for bit.
 inline constexpr int kSolverRevision = 18;
 
 struct SimParams {
