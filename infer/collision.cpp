@@ -43,6 +43,11 @@ Groups group_hr(const std::vector<int>& nearest, int num_lr) {
   return g;
 }
 
+// Appends the HR vertices of LR vertex i to `rows`.
+void append_group(const Groups& g, int i, std::vector<int>& rows) {
+  rows.insert(rows.end(), g.items.begin() + g.offsets[i], g.items.begin() + g.offsets[i + 1]);
+}
+
 // Moves row v of G along n out of the plane (p, n) to offset sigma; true when it moved.
 bool push_out_of_plane(int v, const Vec3& p, const Vec3& n, double sigma, Points3& G) {
   const Vec3 x = G.row(v).transpose();
@@ -180,8 +185,7 @@ CollisionStats resolve_collisions(const CollisionConfig& cfg, const CollisionInp
       if (cfg.sigma_b - (C.row(i).transpose() - p).dot(nb) > 0) {
         ++st.lr_body;
         if (cfg.hr_planes)
-          candidates.insert(candidates.end(), groups.items.begin() + groups.offsets[i],
-                            groups.items.begin() + groups.offsets[i + 1]);
+          append_group(groups, i, candidates);
         else
           st.hr_body += push_group(groups, i, p, nb, cfg.sigma_b, G);
       }
@@ -216,8 +220,7 @@ CollisionStats resolve_collisions(const CollisionConfig& cfg, const CollisionInp
         if (d2 < cfg.gamma * cfg.gamma && cfg.sigma_l - (C.row(e).transpose() - ci).dot(ni) > 0) {
           ++st.lr_layer;
           if (cfg.hr_planes)
-            candidates.insert(candidates.end(), groups.items.begin() + groups.offsets[e],
-                              groups.items.begin() + groups.offsets[e + 1]);
+            append_group(groups, e, candidates);
           else
             st.hr_layer += push_group(groups, e, ci, ni, cfg.sigma_l, G);
         }
