@@ -171,18 +171,29 @@ void measure_arms(const gdsr::TriMesh& b, BodyLandmarks& lm) {
 // Trunk box, shoulder top and neck section (see the header).
 void measure_upper_trunk(const gdsr::TriMesh& b, BodyLandmarks& lm) {
   const double s = lm.height / 1.75;
+  // An A-pose arm hangs within reach of the axis beside the upper trunk: its points (beyond
+  // the shoulder joint, within the arm's radius of its line) are not trunk.
+  auto on_arm = [&](const Vec3& p) {
+    for (int k = 0; k < 2; ++k) {
+      if (!lm.arm_found[k]) continue;
+      const double t = (p - lm.arm_root[k]).dot(lm.arm_dir[k]);
+      if (t > 0 && ((p - lm.arm_root[k]) - t * lm.arm_dir[k]).norm() < lm.arm_r[k] + 0.005 * s) return true;
+    }
+    return false;
+  };
   auto box = [&](double y0, double y1, double rmin, double rmax, Vec3& lo, Vec3& hi) {
     lo = Vec3::Constant(1e300);
     hi = Vec3::Constant(-1e300);
     for (int v = 0; v < b.V.rows(); ++v) {
       const double y = b.V(v, 1), r = std::hypot(b.V(v, 0) - lm.axis.x(), b.V(v, 2) - lm.axis.z());
-      if (y < y0 || y > y1 || r < rmin || r > rmax) continue;
+      if (y < y0 || y > y1 || r < rmin || r > rmax || on_arm(b.V.row(v).transpose())) continue;
       lo = lo.cwiseMin(Vec3(b.V.row(v)));
       hi = hi.cwiseMax(Vec3(b.V.row(v)));
     }
     if (lo.x() > hi.x()) lo = hi = Vec3(lm.axis.x(), y0, lm.axis.z());
   };
-  box(lm.hip_y, lm.armpit_y, 0, 0.26 * s, lm.trunk_lo, lm.trunk_hi);
+  lm.shirt_hem_y = lm.hip_y + 0.4 * (lm.waist_y - lm.hip_y);
+  box(lm.shirt_hem_y, lm.armpit_y, 0, 0.26 * s, lm.trunk_lo, lm.trunk_hi);
   lm.shoulder_top_y = lm.shoulder_y;
   for (int v = 0; v < b.V.rows(); ++v) {
     const double dx = std::abs(b.V(v, 0) - lm.axis.x());

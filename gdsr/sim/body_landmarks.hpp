@@ -26,7 +26,10 @@ struct BodyLandmarks {
   // from the axis (arms beside the trunk left out); never above bust_r.
   double bust_y = 0;
   std::vector<double> bust_profile;
-  // Bounding box of the trunk between hips and armpits (points within 0.26 m x H / 1.75 of the axis).
+  // A t-shirt's hem height (40% of the way from hips to waist), and the bounding box of the trunk
+  // between it and the armpits (points within 0.26 m x H / 1.75 of the axis, those of a found arm
+  // beyond its shoulder joint left out): the section a shirt must clear, not the hips under it.
+  double shirt_hem_y = 0;
   gdsr::Vec3 trunk_lo = gdsr::Vec3::Zero(), trunk_hi = gdsr::Vec3::Zero();
   // Top of the shoulders between neck and shoulder joints, and the bounding box of the neck
   // (and chin) from 0.5 cm to 6 cm above it.

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -75,14 +76,26 @@ struct Shirt {
                              static_cast<int>(arc.size()) - 2);
     return psi[i] + (s - arc[i]) / (arc[i + 1] - arc[i]) * (psi[i + 1] - psi[i]);
   }
-  // Exit parameter t of the sleeve's generator at angle th through the torso cylinder.
-  double hit(const Sleeve& q, double th) const {
+  // Exit parameter t of the sleeve's generator at angle th through the torso cylinder; NaN when
+  // the line misses it.
+  double exit_t(const Sleeve& q, double th) const {
     const Vec3 p0 = q.at(0, th), dir = q.d + q.slope * q.normal(th);  // t along d: n(th) is normal to d
     const double q0 = (p0.x() - cx) / A, q1 = dir.x() / A, w0 = (p0.z() - cz) / B, w1 = dir.z() / B;
     const double a = q1 * q1 + w1 * w1, b = q0 * q1 + w0 * w1, c = q0 * q0 + w0 * w0 - 1;
     const double disc = b * b - a * c;
-    if (!(disc >= 0) || a < 1e-12) gdsr::fail("sim/garment_tshirt", "sleeve line misses the torso cylinder");
+    if (!(disc > 0) || a < 1e-12) return std::numeric_limits<double>::quiet_NaN();
     return (-b + std::sqrt(disc)) / a;
+  }
+  double hit(const Sleeve& q, double th) const {
+    const double t = exit_t(q, th);
+    if (std::isnan(t)) gdsr::fail("sim/garment_tshirt", "sleeve line misses the torso cylinder");
+    return t;
+  }
+  bool sleeves_cross_torso() const {
+    for (const Sleeve& q : sl)
+      for (int j = 0; j < 64; ++j)
+        if (std::isnan(exit_t(q, 2 * kPi * j / 64))) return false;
+    return true;
   }
   // Flat point (relative to the torso panel's origin) of 3-D torso point P; back: panel 1.
   Vec2 torso_flat(const Vec3& P, int panel) const {
@@ -109,19 +122,35 @@ GarmentDesign design_tshirt(const BodyLandmarks& lm) {
   auto sh = std::make_shared<Shirt>();
   Shirt& T = *sh;
   const double ease = 0.035 * s;  // over the trunk's bounding box (a rounded pelvis bulges diagonally)
-  T.hem_y = lm.hip_y + 0.4 * (lm.waist_y - lm.hip_y);
+  T.hem_y = lm.shirt_hem_y;
   T.cx = lm.axis.x();
-  T.cz = 0.5 * (lm.arm_root[0].z() + lm.arm_root[1].z());  // side seams in the arms' plane
-  double rs = 0, rw = 0;                                   // sleeve radius at the shoulder joint and at the cuff
+  double rs = 0, rw = 0;  // sleeve radius at the shoulder joint and at the cuff
   for (int k = 0; k < 2; ++k) {
     rs = std::max(rs, lm.arm_r[k] + 0.02 * s);
     rw = std::max(rw, lm.wrist_r[k] + kCuffEase * s);
   }
   rw = std::min(rw, rs);
+  // Side seams through the trunk's centre, moved towards the arms' plane only as far as the
+  // sleeves need to cross them: in the arms' plane (4-8 cm behind the trunk's centre on the CMU
+  // bodies) the ellipse had to reach that much further forward, a shirt 40-48 cm deep on a 25 cm trunk.
+  const double arms_z = 0.5 * (lm.arm_root[0].z() + lm.arm_root[1].z());
+  T.cz = std::clamp(0.5 * (lm.trunk_lo.z() + lm.trunk_hi.z()), arms_z - 0.5 * rs, arms_z + 0.5 * rs);
   T.A = std::max({lm.trunk_hi.x() - T.cx, T.cx - lm.trunk_lo.x()}) + ease;
-  T.A = std::max({T.A, std::abs(lm.arm_root[0].x() - T.cx) + 0.01 * s, std::abs(lm.arm_root[1].x() - T.cx) + 0.01 * s});
+  T.A = std::max({T.A, std::abs(lm.arm_root[0].x() - T.cx) + 0.05 * s, std::abs(lm.arm_root[1].x() - T.cx) + 0.05 * s});
   T.B = std::max({lm.trunk_hi.z() - T.cz, T.cz - lm.trunk_lo.z(), rs + 0.03 * s}) + ease;
   for (int k = 0; k < 2; ++k) T.B = std::max(T.B, std::abs(lm.arm_root[k].z() - T.cz) + rs + 0.03 * s);
+  for (int k = 0; k < 2; ++k) {
+    Sleeve& q = T.sl[k];
+    q.root = lm.arm_root[k];
+    q.d = lm.arm_dir[k];
+    q.rs = rs;
+    q.t_wrist = lm.arm_len[k];
+    q.slope = (rw - rs) / q.t_wrist;
+    q.e1 = (-Vec3::UnitY() + q.d * q.d.y()).normalized();
+    q.e2 = q.e1.cross(q.d);
+  }
+  // Deeper where a sleeve's generators, on arms held forward, would pass in front of the torso.
+  for (int grow = 0; grow < 60 && !T.sleeves_cross_torso(); ++grow) T.B *= 1.03;
   // Ellipse arc length table.
   const int M = 20000;
   T.psi.resize(M + 1);
@@ -139,13 +168,6 @@ GarmentDesign design_tshirt(const BodyLandmarks& lm) {
   double y_hole_top = -1e300, y_hole_bot = 1e300;
   for (int k = 0; k < 2; ++k) {
     Sleeve& q = T.sl[k];
-    q.root = lm.arm_root[k];
-    q.d = lm.arm_dir[k];
-    q.rs = rs;
-    q.t_wrist = lm.arm_len[k];
-    q.slope = (rw - rs) / q.t_wrist;
-    q.e1 = (-Vec3::UnitY() + q.d * q.d.y()).normalized();
-    q.e2 = q.e1.cross(q.d);
     auto f = [&](double th) { return q.at(T.hit(q, th), th).z() - T.cz; };
     const double sgn = f(kPi / 2) > 0 ? 1.0 : -1.0;  // sign of f on the first half
     if (!(sgn * f(-kPi / 2) < 0 && sgn * f(3 * kPi / 2) < 0))
