@@ -549,21 +549,21 @@ void ClothSolver::solve_body_contacts(const Points3& body_prev, const Points3& b
   for (size_t k = 0; k < contacts_.size(); ++k) {
     const Contact& c = contacts_[k];
     if (c.v != pushed_v) pushed_v = c.v, pushed = 0;
+    const double C = depth(c);
+    if (C >= 0) continue;
     // Cloth without a pin inside two parts at once (an arm pressed into the chest): each push
     // would move it onto one part's surface inside the other, and sleeve and shirt, pushed onto
     // their own parts, would swap sides. Held where it is, self-contact keeps the layers in order.
+    // (A vertex has at most two contacts, next to each other.)
     if (p_.hold_unpinned_pinches && !anchored_[c.v]) {
-      const bool pair_next = k + 1 < contacts_.size() && contacts_[k + 1].v == c.v;
-      const bool pair_prev = k > 0 && contacts_[k - 1].v == c.v;
-      if ((pair_next && depth(c) < 0 && depth(contacts_[k + 1]) < 0) ||
-          (pair_prev && depth(c) < 0 && depth(contacts_[k - 1]) < 0))
-        continue;
+      const size_t other = k + 1 < contacts_.size() && contacts_[k + 1].v == c.v ? k + 1
+                           : k > 0 && contacts_[k - 1].v == c.v                  ? k - 1
+                                                                                 : k;
+      if (other != k && depth(contacts_[other]) < 0) continue;
     }
     const Vec3 q = bary_point(body_now, bodyF_, c.face, c.bary);
     const Vec3 nrm = face_normal(body_now, bodyF_, c.face);
     Vec3 x = x_.row(c.v).transpose();
-    const double C = depth(c);
-    if (C >= 0) continue;
     const Vec3 qprev = bary_point(body_prev, bodyF_, c.face, c.bary);
     if (c.passing && (q - qprev).dot(nrm) > 0) continue;  // a limb that went through it does not push it on
     const double push =
