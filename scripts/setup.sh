@@ -31,7 +31,7 @@ if [ ! -f viewer/node_modules/three/build/three.module.js ]; then
   (cd viewer && npm install --no-package-lock --no-audit --no-fund --loglevel=error >/dev/null)
 fi
 
-jobs=$(nproc 2>/dev/null || echo 2)
+jobs=$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc 2>/dev/null || echo 2)  # nproc honours OMP_NUM_THREADS
 # GDSR_CMAKE_ARGS: extra configure flags for a fresh build/ (CI passes -DGDSR_WERROR=ON;
 # -DGDSR_MARCH=x86-64-v2 makes a build that runs on any x86-64 machine from 2009 on).
 if [ ! -f build/CMakeCache.txt ]; then
