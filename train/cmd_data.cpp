@@ -263,6 +263,7 @@ void run_make(const MakeArgs& a) {
                   {"self_slack_per_pd", params.self_slack_per_pd},
                   {"self_detect_every", params.self_detect_every},
                   {"self_passes", params.self_passes},
+                  {"self_crossed_push", params.self_crossed_push},
                   {"untangle_step", params.untangle_step},
                   {"hr_track_rate_1_s", params.track_rate},
                   {"compression_ratio", params.compression_ratio},

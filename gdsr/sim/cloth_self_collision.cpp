@@ -478,7 +478,7 @@ int SelfCollision::untangle(Points3& x, const std::vector<double>& winv, double 
   return crossing;
 }
 
-int SelfCollision::project(Points3& x, const std::vector<double>& winv, double thickness) {
+int SelfCollision::project(Points3& x, const std::vector<double>& winv, double thickness, double max_crossed_push) {
   int pushed = 0;
   for (auto& c : vt_) {
     const int ia = F_(c.f, 0), ib = F_(c.f, 1), ic = F_(c.f, 2);
@@ -491,7 +491,7 @@ int SelfCollision::project(Points3& x, const std::vector<double>& winv, double t
       if (dist != 0) c.side = dist > 0 ? 1 : -1;
       continue;
     }
-    const double C = c.side * dist - thickness;
+    const double C = std::max(c.side * dist - thickness, -max_crossed_push);
     if (C >= 0) continue;
     const double wp = winv[c.v], wa = winv[ia], wb = winv[ib], wc = winv[ic];
     const double wsum = wp + bary.x() * bary.x() * wa + bary.y() * bary.y() * wb + bary.z() * bary.z() * wc;
@@ -522,7 +522,7 @@ int SelfCollision::project(Points3& x, const std::vector<double>& winv, double t
     // Same side but too close: push along the current separation; crossed: push back
     // along the remembered side.
     Vec3 n = dir;
-    double C = along - thickness;
+    double C = std::max(along - thickness, -max_crossed_push);
     if (along > 0 && len > 0) {
       n = d / len;
       C = len - thickness;

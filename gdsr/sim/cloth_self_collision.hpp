@@ -36,6 +36,7 @@
 #include <algorithm>
 #include <array>
 #include <memory>
+#include <limits>
 #include <vector>
 
 namespace sim {
@@ -58,8 +59,11 @@ class SelfCollision {
 
   // One Gauss-Seidel pass over the pairs (fixed order): pushes pairs closer than
   // `thickness` apart along the triangle normal / edge-edge normal, by inverse masses winv
-  // (0 = fixed). Returns the number of pairs that were pushed.
-  int project(gdsr::Points3& x, const std::vector<double>& winv, double thickness);
+  // (0 = fixed), by at most `max_crossed_push` metres: set it to `thickness` or more, and it
+  // limits only pairs found crossed (on the other side from the one they were detected on,
+  // within their reach). Returns the number of pairs that were pushed.
+  int project(gdsr::Points3& x, const std::vector<double>& winv, double thickness,
+              double max_crossed_push = std::numeric_limits<double>::infinity());
 
   // One step of intersection contour minimisation over the edge-face crossings of the last
   // tangle test that still cross in x: the edge and the face are moved apart (by inverse

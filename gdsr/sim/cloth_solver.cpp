@@ -208,10 +208,10 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
   xprev_ = x_;
   if (p.self_collision) {
     if (!(p.self_thickness > 0) || p.self_detect_every < 1 || !(p.self_slack > 0) || p.self_passes < 1 ||
-        !(p.self_thickness_per_pd >= 0) || !(p.self_slack_per_pd > 0))
+        !(p.self_thickness_per_pd >= 0) || !(p.self_slack_per_pd > 0) || !(p.self_crossed_push >= 1))
       gdsr::fail("sim/cloth_solver",
                  "self_thickness, self_slack and self_slack_per_pd must be positive, self_thickness_per_pd >= 0, "
-                 "self_detect_every and self_passes >= 1");
+                 "self_crossed_push, self_detect_every and self_passes >= 1");
     p_.self_thickness = std::max(p.self_thickness, p.self_thickness_per_pd * g.particle_distance);
     if (g.particle_distance > 0) p_.self_slack = std::min(p.self_slack, p.self_slack_per_pd * g.particle_distance);
     const double longer = std::round(p.self_detect_every * (p.self_slack / p_.self_slack));
@@ -587,7 +587,8 @@ void ClothSolver::solve_self_contacts() {
   // margin) instead of being pressed onto one surface. A few passes: contacts share
   // vertices, and one Gauss-Seidel pass leaves them coupled.
   if (!self_) return;
-  for (int k = 0; k < p_.self_passes && self_->project(x_, winv_, p_.self_thickness) > 0; ++k) {
+  const double max_crossed_push = p_.self_crossed_push * p_.self_thickness;
+  for (int k = 0; k < p_.self_passes && self_->project(x_, winv_, p_.self_thickness, max_crossed_push) > 0; ++k) {
   }
 }
 

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <omp.h>
 #include <utility>
 
@@ -310,9 +311,10 @@ namespace {
 // Frames with skirt cloth more than 5 mm inside the body in the last 20 of the 30 mm skirt on
 // CMU 131_01 from 2 s for 2 s (76 frames with the rest blend): a swinging hand goes into the
 // skirt at frame 20 and has passed it by frame 40.
-int walking_hand_deep_frames_at_end(const std::string& bvh, bool limbs_pass_through) {
+int walking_hand_deep_frames_at_end(const std::string& bvh, bool limbs_pass_through, double self_crossed_push = 1) {
   sim::SimParams p;
   p.limbs_pass_through = limbs_pass_through;
+  p.self_crossed_push = self_crossed_push;
   const GarmentRun run = run_on_clip("skirt_short", bvh, 2, 2, p);
   REQUIRE(run.frames.size() == 76);
   int deep = 0;
@@ -336,9 +338,11 @@ TEST_CASE("cloth: a hand that went through the pinned skirt passes on instead of
   const int with = walking_hand_deep_frames_at_end(bvh, true);
   MESSAGE("last 20 frames with cloth > 5 mm inside the body, limbs pass through: " << with);
   CHECK(with <= 2);
-  const int without = walking_hand_deep_frames_at_end(bvh, false);  // the test can fail: the hand carries the skirt
-  MESSAGE("... the hand carries the cloth: " << without);
-  CHECK(without >= 15);
+  // Since revision 20 the wrapped ring no longer forms on this clip without the rule either (0
+  // frames): self-contact pushed crossed cloth back all the way then, and the control runs so.
+  const int without = walking_hand_deep_frames_at_end(bvh, false, std::numeric_limits<double>::infinity());
+  MESSAGE("... the hand carries the cloth (self-contact of revision 19): " << without);
+  CHECK(without >= 15);  // the test can fail: the hand carries the skirt
 }
 
 namespace {

@@ -330,6 +330,36 @@ TEST_CASE("self-collision: a vertex found beyond its reach on the wrong side is 
   CHECK(z(3, 1) == -0.04);
 }
 
+TEST_CASE("self-collision: a pair found deep across, within its reach, is pushed back by at most the cap per pass") {
+  // A triangle and a lone vertex as above (a larger triangle: no corner within the vertex's
+  // reach), detected while the vertex moves 5 cm down (reach 3 + 50 + 2 mm): found 3 cm
+  // across, it was pushed all the way back, 33 mm in one pass; with the solver's cap
+  // (SimParams::self_crossed_push, one thickness) it moves 3 mm a pass. A pair just too close
+  // is pushed as before: the cap limits only crossed pairs.
+  const gdsr::Faces F = (gdsr::Faces(2, 3) << 0, 1, 2, 3, 4, 5).finished();
+  Points3 x(6, 3);
+  x << 0, 0, 0, 0.3, 0, 0, 0, 0, 0.3, 0.08, 0.002, 0.08, 1, 1, 1, 1.01, 1, 1;
+  Points3 motion = Points3::Zero(6, 3);
+  motion(3, 1) = -0.05;
+  const std::vector<double> winv = {0, 0, 0, 1, 1, 1};
+  const double thickness = 0.003, slack = 0.001;
+  sim::SelfCollision sc(F, 6);
+  sc.detect(x, motion, slack, thickness);
+  REQUIRE(sc.num_vertex_triangle() == 1);
+  Points3 all = x, capped = x;
+  all(3, 1) = capped(3, 1) = -0.03;
+  CHECK(sc.project(all, winv, thickness) == 1);
+  CHECK(all(3, 1) == doctest::Approx(thickness).epsilon(1e-9));
+  CHECK(sc.project(capped, winv, thickness, thickness) == 1);
+  CHECK(capped(3, 1) == doctest::Approx(-0.03 + thickness).epsilon(1e-9));
+  for (int pass = 0; pass < 20; ++pass) sc.project(capped, winv, thickness, thickness);
+  CHECK(capped(3, 1) == doctest::Approx(thickness).epsilon(1e-9));  // back on its side within 11 passes
+  Points3 close = x;  // 1 mm above: pushed to the thickness in one pass, capped or not
+  close(3, 1) = 0.001;
+  CHECK(sc.project(close, winv, thickness, thickness) == 1);
+  CHECK(close(3, 1) == doctest::Approx(thickness).epsilon(1e-9));
+}
+
 TEST_CASE("self-collision: resting layers are kept the larger of the thickness and a sixth of the particle distance apart") {
   // The dropped sheet of the test above, 1.5 s later at rest on the clamped one: the gap from
   // each upper vertex over the middle to the nearest lower triangle (brute force), median.
