@@ -35,8 +35,8 @@
 
 #include <algorithm>
 #include <array>
-#include <memory>
 #include <limits>
+#include <memory>
 #include <vector>
 
 namespace sim {

@@ -705,6 +705,11 @@ TEST_CASE("cloth: bad inputs are rejected") {
     q.max_push_step = step;
     CHECK_THROWS_AS(sim::ClothSolver(g, gdsr::Faces(), Points3(), q), gdsr::Error);
   }
+  for (const double push : {0.5, -1.0, std::nan("")}) {  // below one thickness it would limit every contact
+    sim::SimParams q;
+    q.self_crossed_push = push;
+    CHECK_THROWS_AS(sim::ClothSolver(g, gdsr::Faces(), Points3(), q), gdsr::Error);
+  }
   auto sphere = sim::make_sphere(Vec3(0, -1, 0), 0.2, 8, 16);
   std::vector<Points3> frames{sphere.V, Points3(sphere.V.topRows(5))};
   CHECK_THROWS_AS(sim::simulate_frames(g, sphere.F, frames, 30.0, sim::SimParams()), std::runtime_error);
