@@ -34,6 +34,13 @@
 #   97.8% and 69.1% for 1, 2 and 3 passes; at k = 2 100% for all three):
 #     bench/sim_sweep.sh build OUT --self-passes "1 2 3" pants ../shared/motions/cmu-salsa/61_03.bvh 2 4 \
 #       "--hr-pd 0.03 --compression-exponent 1"
+# - the t-shirt on salsa 61_03 at 30 mm, where a bent elbow swallows the sleeve (SimParams::
+#   hold_unpinned_pinches): frames with cloth > 5 mm inside the body outside pinches / frames
+#   threaded / LR mean E_u (revision 20): default 98 / 32 / 0.0042; --contact-every 1 96 / 29 /
+#   0.0034; --substeps 40 84 / 23 / 0.0051; --pinch-separation 0.2 98 / 32 / 0.0038 (LR frames free
+#   of self-intersections 100 -> 25.7%), 0.25 98 / 39 / 0.0031; all within the friction spread
+#   (--friction 0.30001: 91 / 35 / 0.0039):
+#     bench/sim_sweep.sh build OUT --contact-every "5 1" tshirt ../shared/motions/cmu-salsa/61_03.bvh 2 4 "--hr-pd 0.03"
 set -e
 usage="usage: $0 BUILD_DIR OUT_DIR OPTION VALUES [GARMENT] [MOTION] [START_S] [SECONDS] [FLAGS]"
 build=$(cd "${1:?$usage}" && pwd)

@@ -241,7 +241,25 @@ struct SimParams {
                                       // is not pushed by either: pushed onto the surface of the part it was dressed
                                       // on, which lies inside the other, the sleeve's underside and the shirt's side
                                       // swapped sides in the armpit. Held, self-contact keeps the layers in order
-                                      // (revision 19 has the figures). Cloth with pins is unchanged
+                                      // (revision 19 has the figures). Cloth with pins is unchanged.
+                                      // The cost, on salsa 61_03 (2-6 s): a bent elbow (upper arm and forearm are
+                                      // parts 16 cm apart) holds the sleeve in its crease and the arm moves on
+                                      // through it; the sleeve ends off the arm, 25-37 mm inside it, from frame ~55.
+                                      // Tried at revision 20, none kept (30 mm, frames with cloth > 5 mm inside the
+                                      // body outside pinches / frames threaded / mean E_u; the default 98 / 32 /
+                                      // 0.0042, and 91 / 35 / 0.0039 with the friction nudged by 1e-5): held only
+                                      // where truly inside the other part 80 / 13 / 0.0038 and 79 / 22 / 0.0044, but
+                                      // at 10 mm (2-3.5 s) LR / HR frames free of self-intersections 100 / 100% ->
+                                      // 73.8 / 57.4%; held only 2 mm inside it 96 / 22 / 0.0044; contacts at any depth
+                                      // within reach for cloth without pins (not only within max_push) 85 / 24 /
+                                      // 0.0049; held cloth carried by the two parts' mean motion 95 / 48 / 0.0044;
+                                      // pushed out of the overlap along the sum of the two normals, max_push_step a
+                                      // pass, 98 / 34 / 0.0056 and 98 / 7 / 0.0035 (LR 94.9% free of
+                                      // self-intersections); not held where both parts lie within pinch_separation
+                                      // of the vertex's first-pose home (a joint's crease) 91 / 26 / 0.0034 (the
+                                      // 30 mm run that follows it 26.5% free of self-intersections);
+                                      // limbs_pass_through for cloth without pins 49 / 18 / 0.0014, but the shirt
+                                      // then passes through the trunk and falls off the body
   double max_speed = 15;                         // m/s, velocity clamp (safety against fast body parts)
   int settle_frames = 30;      // frames simulated on the first body pose before frame 0 (velocities zeroed at the end)
   double settle_rest_blend = 0.5;  // fraction of settle_frames over which rest lengths go from the placement to the pattern
