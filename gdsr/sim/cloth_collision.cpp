@@ -7,79 +7,115 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 #include <stdexcept>
 
 namespace sim {
 
 using gdsr::Vec3;
 
-long long SurfaceGrid::key(int i, int j, int k) const {
-  const long long m = 1 << 20;
-  return ((static_cast<long long>(i) + m / 2) * m + (j + m / 2)) * m + (k + m / 2);
-}
-
 void SurfaceGrid::build(const gdsr::Faces& F, const gdsr::Points3& V0, const gdsr::Points3& V1, double cell) {
   if (!(cell > 0)) gdsr::fail("sim/cloth_collision", "grid cell must be positive");
   if (V0.rows() != V1.rows()) gdsr::fail("sim/cloth_collision", "pose vertex counts differ");
   F_ = &F;
   cell_ = cell;
-  cells_.clear();
-  if (V0.rows() == 0) return;
+  start_.clear();
+  faces_.clear();
+  if (V0.rows() == 0 || F.rows() == 0) return;
   origin_ = V0.colwise().minCoeff().transpose();
+  // Cell range of each face's box over both poses.
+  std::vector<Eigen::Vector3i> a(F.rows()), b(F.rows());
+  Eigen::Vector3i lo = Eigen::Vector3i::Constant(std::numeric_limits<int>::max());
+  Eigen::Vector3i hi = Eigen::Vector3i::Constant(std::numeric_limits<int>::min());
   for (int f = 0; f < F.rows(); ++f) {
-    Vec3 lo = V0.row(F(f, 0)).transpose(), hi = lo;
+    Vec3 flo = V0.row(F(f, 0)).transpose(), fhi = flo;
     for (int k = 0; k < 3; ++k) {
-      lo = lo.cwiseMin(V0.row(F(f, k)).transpose()).cwiseMin(V1.row(F(f, k)).transpose());
-      hi = hi.cwiseMax(V0.row(F(f, k)).transpose()).cwiseMax(V1.row(F(f, k)).transpose());
+      flo = flo.cwiseMin(V0.row(F(f, k)).transpose()).cwiseMin(V1.row(F(f, k)).transpose());
+      fhi = fhi.cwiseMax(V0.row(F(f, k)).transpose()).cwiseMax(V1.row(F(f, k)).transpose());
     }
-    const Eigen::Vector3i a = ((lo - origin_) / cell_).array().floor().cast<int>();
-    const Eigen::Vector3i b = ((hi - origin_) / cell_).array().floor().cast<int>();
-    for (int i = a.x(); i <= b.x(); ++i)
-      for (int j = a.y(); j <= b.y(); ++j)
-        for (int k = a.z(); k <= b.z(); ++k) cells_[key(i, j, k)].push_back(f);
+    if (!flo.allFinite() || !fhi.allFinite()) gdsr::fail("sim/cloth_collision", "body positions are not finite");
+    a[f] = ((flo - origin_) / cell_).array().floor().cast<int>();
+    b[f] = ((fhi - origin_) / cell_).array().floor().cast<int>();
+    lo = lo.cwiseMin(a[f]);
+    hi = hi.cwiseMax(b[f]);
   }
+  lo_ = lo;
+  dims_ = hi - lo + Eigen::Vector3i::Ones();
+  if (static_cast<double>(dims_.x()) * dims_.y() * dims_.z() > 1e7)
+    gdsr::fail("sim/cloth_collision", "body spans too many grid cells (the two poses are far apart)");
+  const size_t ncells = static_cast<size_t>(dims_.x()) * dims_.y() * dims_.z();
+  start_.assign(ncells + 1, 0);
+  auto each_cell = [&](int f, auto&& fn) {
+    for (int i = a[f].x(); i <= b[f].x(); ++i)
+      for (int j = a[f].y(); j <= b[f].y(); ++j)
+        for (int k = a[f].z(); k <= b[f].z(); ++k)
+          fn((static_cast<size_t>(i - lo_.x()) * dims_.y() + (j - lo_.y())) * dims_.z() + (k - lo_.z()));
+  };
+  for (int f = 0; f < F.rows(); ++f) each_cell(f, [&](size_t c) { ++start_[c + 1]; });
+  for (size_t c = 0; c < ncells; ++c) start_[c + 1] += start_[c];
+  faces_.resize(start_[ncells]);
+  std::vector<int> fill(start_.begin(), start_.end() - 1);
+  for (int f = 0; f < F.rows(); ++f) each_cell(f, [&](size_t c) { faces_[fill[c]++] = f; });
 }
 
 SurfaceHit SurfaceGrid::closest(const Vec3& x, const gdsr::Points3& V, double radius,
                                 const std::function<bool(int)>& accept) const {
   SurfaceHit hit;
-  if (cells_.empty()) return hit;
+  if (faces_.empty() || !x.allFinite()) return hit;
   const auto& F = *F_;
-  const Eigen::Vector3i a = ((x.array() - radius - origin_.array()) / cell_).floor().cast<int>();
-  const Eigen::Vector3i b = ((x.array() + radius - origin_.array()) / cell_).floor().cast<int>();
-  double best = radius * radius;
-  thread_local std::vector<int> cand;  // reused: one allocation per thread, not per query
-  cand.clear();
-  for (int i = a.x(); i <= b.x(); ++i)
-    for (int j = a.y(); j <= b.y(); ++j)
-      for (int k = a.z(); k <= b.z(); ++k) {
-        auto it = cells_.find(key(i, j, k));
-        if (it != cells_.end()) cand.insert(cand.end(), it->second.begin(), it->second.end());
-      }
-  std::sort(cand.begin(), cand.end());
-  cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
-  Vec3 nsum = Vec3::Zero();
-  for (int f : cand) {
-    const Vec3 p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
-    // A face whose box is farther than the best distance so far (with room for rounding) can
-    // neither win nor tie: skip the exact test (the result is the same, bit for bit; with the
-    // lazy normals below, the queries take 28% less time on the 10 mm skirt).
-    const Vec3 gap = (p0.cwiseMin(p1).cwiseMin(p2) - x).cwiseMax(x - p0.cwiseMax(p1).cwiseMax(p2)).cwiseMax(0.0);
-    if (gap.squaredNorm() > best + 2e-14) continue;
-    if (accept && !accept(f)) continue;
-    const Vec3 bc = gdsr::closest_point_on_triangle(x, p0, p1, p2).bary;
-    const Vec3 q = bc.x() * p0 + bc.y() * p1 + bc.z() * p2;
-    const double d2 = (x - q).squaredNorm();
-    if (d2 < best - 1e-14) {
-      best = d2;
-      hit.face = f;
-      hit.bary = bc;
-      hit.point = q;
-      nsum = (p1 - p0).cross(p2 - p0).normalized();
-    } else if (hit.face >= 0 && d2 <= best + 1e-14) {
-      nsum += (p1 - p0).cross(p2 - p0).normalized();  // shared edge/vertex: average the faces' normals
-    }
+  // The query box's cells, clipped to the block that holds faces (floor in double: a point far
+  // outside does not overflow an int).
+  Eigen::Vector3i a, b;
+  for (int c = 0; c < 3; ++c) {
+    const double lo = std::floor((x[c] - radius - origin_[c]) / cell_) - lo_[c];
+    const double hi = std::floor((x[c] + radius - origin_[c]) / cell_) - lo_[c];
+    if (hi < 0 || lo >= dims_[c]) return hit;
+    a[c] = static_cast<int>(std::max(lo, 0.0));
+    b[c] = static_cast<int>(std::min(hi, dims_[c] - 1.0));
   }
+  // Candidate faces, each once and in ascending order (ties go to the lower face id): marked in
+  // a bit set, then read out word by word (sorting them was a quarter of the query time).
+  thread_local std::vector<uint64_t> marked;  // reused: one allocation per thread, not per query
+  const size_t words = (static_cast<size_t>(F.rows()) + 63) / 64;
+  if (marked.size() < words) marked.assign(words, 0);
+  size_t wlo = words, whi = 0;
+  for (int i = a.x(); i <= b.x(); ++i)
+    for (int j = a.y(); j <= b.y(); ++j) {
+      const size_t row = (static_cast<size_t>(i) * dims_.y() + j) * dims_.z();
+      for (int k = a.z(); k <= b.z(); ++k)
+        for (int n = start_[row + k], e = start_[row + k + 1]; n < e; ++n) {
+          const size_t w = static_cast<size_t>(faces_[n]) >> 6;
+          marked[w] |= uint64_t{1} << (faces_[n] & 63);
+          wlo = std::min(wlo, w);
+          whi = std::max(whi, w);
+        }
+    }
+  double best = radius * radius;
+  Vec3 nsum = Vec3::Zero();
+  for (size_t w = wlo; w <= whi && wlo < words; ++w)
+    for (uint64_t bits = std::exchange(marked[w], 0); bits; bits &= bits - 1) {
+      const int f = static_cast<int>(w * 64 + __builtin_ctzll(bits));
+      const Vec3 p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
+      // A face whose box is farther than the best distance so far (with room for rounding) can
+      // neither win nor tie: skip the exact test (the result is the same, bit for bit; with the
+      // lazy normals below, the queries take 28% less time on the 10 mm skirt).
+      const Vec3 gap = (p0.cwiseMin(p1).cwiseMin(p2) - x).cwiseMax(x - p0.cwiseMax(p1).cwiseMax(p2)).cwiseMax(0.0);
+      if (gap.squaredNorm() > best + 2e-14) continue;
+      if (accept && !accept(f)) continue;
+      const Vec3 bc = gdsr::closest_point_on_triangle(x, p0, p1, p2).bary;
+      const Vec3 q = bc.x() * p0 + bc.y() * p1 + bc.z() * p2;
+      const double d2 = (x - q).squaredNorm();
+      if (d2 < best - 1e-14) {
+        best = d2;
+        hit.face = f;
+        hit.bary = bc;
+        hit.point = q;
+        nsum = (p1 - p0).cross(p2 - p0).normalized();
+      } else if (hit.face >= 0 && d2 <= best + 1e-14) {
+        nsum += (p1 - p0).cross(p2 - p0).normalized();  // shared edge/vertex: average the faces' normals
+      }
+    }
   if (hit.face < 0) return hit;
   hit.normal = nsum.norm() > 0 ? Vec3(nsum.normalized()) : Vec3(0, 1, 0);
   const double d = std::sqrt(best);

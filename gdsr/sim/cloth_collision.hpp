@@ -8,8 +8,9 @@
 
 #include "gdsr/geometry/mesh.hpp"
 
+#include <Eigen/Core>
+#include <cstdint>
 #include <functional>
-#include <unordered_map>
 #include <vector>
 
 namespace sim {
@@ -31,14 +32,16 @@ class SurfaceGrid {
   // when it is given.
   SurfaceHit closest(const gdsr::Vec3& x, const gdsr::Points3& V, double radius,
                      const std::function<bool(int)>& accept = {}) const;
-  bool empty() const { return cells_.empty(); }
+  bool empty() const { return faces_.empty(); }
 
  private:
-  long long key(int i, int j, int k) const;
   const gdsr::Faces* F_ = nullptr;
   double cell_ = 0;
-  gdsr::Vec3 origin_ = gdsr::Vec3::Zero();
-  std::unordered_map<long long, std::vector<int>> cells_;
+  gdsr::Vec3 origin_ = gdsr::Vec3::Zero();  // cell (0, 0, 0) starts here
+  // The cells the face boxes cover, a dense block from cell index lo_ with dims_ cells per
+  // axis, stored compressed: cell c holds faces_[start_[c] .. start_[c + 1]), ascending.
+  Eigen::Vector3i lo_ = Eigen::Vector3i::Zero(), dims_ = Eigen::Vector3i::Zero();
+  std::vector<int> start_, faces_;
 };
 
 }  // namespace sim

@@ -222,8 +222,13 @@ struct SelfCollision::Embree {
     if (kind == 1) return owner->edges_.empty() ? nullptr : owner->edges_.front().data();
     return kind == 2 ? owner->F_.data() : nullptr;
   }
-  std::vector<std::pair<int, int>> collide(RTCScene a, int ka, RTCScene b, int kb) const {
+  // Overlaps found by the last collide of each pair of kinds (vertex-face, edge-edge,
+  // edge-face): the next one reserves that many, as growing the list was 2.5% of a simulation.
+  size_t last_count[3] = {0, 0, 0};
+  std::vector<std::pair<int, int>> collide(RTCScene a, int ka, RTCScene b, int kb) {
     Overlaps o{ids(ka), ids(kb), a == b, {}, {}};
+    size_t& last = last_count[ka == 0 ? 0 : kb];  // vertex-face 0, edge-edge 1, edge-face 2
+    o.pairs.reserve(last + last / 8);
     RTCCollideFunc fn = nullptr;
     if (ka == 0 && kb == 2) fn = gather<1, 3>;
     if (ka == 1 && kb == 1) fn = gather<2, 2>;
@@ -232,6 +237,7 @@ struct SelfCollision::Embree {
     rtcCollide(a, b, fn, &o);
     const RTCError err = rtcGetDeviceError(device);
     if (err != RTC_ERROR_NONE) fail("Embree collide failed (error " + std::to_string(static_cast<int>(err)) + ")");
+    last = o.pairs.size();
     return std::move(o.pairs);  // in callback order: the caller sorts what it keeps
   }
 };

@@ -91,3 +91,49 @@ TEST_CASE("cloth collision: the body grid finds the same closest point as every 
   CHECK(inside > 50);
   CHECK(ties > 200);
 }
+
+TEST_CASE("cloth collision: the body grid at the edges of its cells, far away, with NaN, and beside a second grid") {
+  // Queries whose search box reaches past the block of cells that hold faces (above the head,
+  // below the feet, beside the arms), points far outside it, and a grid of another body queried
+  // in between on the same thread (the candidate set is kept per thread): all as the brute
+  // force finds them.
+  const gdsr::TriMesh body = sim::make_mannequin(1.7);
+  const gdsr::TriMesh small = sim::make_mannequin(0.9);
+  sim::SurfaceGrid grid, other;
+  grid.build(body.F, body.V, body.V, 0.05);
+  other.build(small.F, small.V, small.V, 0.05);
+  const Vec3 lo = body.V.colwise().minCoeff().transpose(), hi = body.V.colwise().maxCoeff().transpose();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0, 1);
+  int found = 0;
+  for (int k = 0; k < 600; ++k) {
+    Vec3 x;
+    for (int c = 0; c < 3; ++c) x[c] = lo[c] + (hi[c] - lo[c]) * u(rng);
+    const int c = k % 3;
+    x[c] = (k / 3) % 2 ? hi[c] + 0.03 * u(rng) : lo[c] - 0.03 * u(rng);  // within the radius of the box's face
+    const sim::SurfaceHit g = grid.closest(x, body.V, 0.034);
+    const sim::SurfaceHit b = brute_force(x, body.F, body.V, 0.034, {});
+    REQUIRE(g.face == b.face);
+    if (b.face >= 0) {
+      CHECK(g.point == b.point);
+      CHECK(g.normal == b.normal);
+      ++found;
+    }
+    const sim::SurfaceHit s = other.closest(x, small.V, 0.034);
+    CHECK(s.face == brute_force(x, small.F, small.V, 0.034, {}).face);
+  }
+  MESSAGE(found << " of 600 queries at the block's faces within reach");
+  CHECK(found > 20);
+  CHECK(grid.closest(Vec3(100, 0, 0), body.V, 0.034).face == -1);
+  CHECK(grid.closest(Vec3(-1e12, 1e12, 0), body.V, 0.034).face == -1);
+  CHECK(grid.closest(Vec3(std::nan(""), 1, 0), body.V, 0.034).face == -1);
+  sim::SurfaceGrid none;
+  none.build(gdsr::Faces(0, 3), body.V, body.V, 0.05);
+  CHECK(none.empty());
+  CHECK(none.closest(Vec3::Zero(), body.V, 1).face == -1);
+  // Two poses kilometres apart would need a block of billions of cells: refused in one line.
+  Points3 far = body.V;
+  far.col(0).array() += 5000;
+  CHECK_THROWS_WITH_AS(grid.build(body.F, body.V, far, 0.05), doctest::Contains("too many grid cells"),
+                       std::runtime_error);
+}
