@@ -118,23 +118,25 @@ TEST_CASE("self-collision: the CGAL yardstick counts crossing triangles and igno
 
 namespace {
 
-// Distance between segments p1q1 and p2q2 (Ericson, Real-Time Collision Detection 5.1.9), the
-// yardstick of the broad-phase test below.
+// Distance between segments p1q1 and p2q2, the yardstick of the broad-phase test below, by
+// another road than the solver's closed form: the distance from p1 + s (q1 - p1) to the other
+// segment is convex in s, so a ternary search over s finds its minimum.
 double segment_distance(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2) {
-  const Vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
-  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r), c = d1.dot(r), b = d1.dot(d2);
-  double s = 0, t = 0;
-  const double denom = a * e - b * b;
-  s = denom > 0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
-  t = (b * s + f) / e;
-  if (t < 0) {
-    t = 0;
-    s = std::clamp(-c / a, 0.0, 1.0);
-  } else if (t > 1) {
-    t = 1;
-    s = std::clamp((b - c) / a, 0.0, 1.0);
+  const Vec3 d2 = q2 - p2;
+  auto to_second = [&](double s) {
+    const Vec3 p = p1 + s * (q1 - p1);
+    const double t = d2.squaredNorm() > 0 ? std::clamp((p - p2).dot(d2) / d2.squaredNorm(), 0.0, 1.0) : 0.0;
+    return (p - (p2 + t * d2)).norm();
+  };
+  double lo = 0, hi = 1;
+  for (int k = 0; k < 100; ++k) {  // (2/3)^100 ~ 2e-18 of the first segment's length
+    const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
+    if (to_second(m1) < to_second(m2))
+      hi = m2;
+    else
+      lo = m1;
   }
-  return ((p1 + s * d1) - (p2 + t * d2)).norm();
+  return to_second(0.5 * (lo + hi));
 }
 
 }  // namespace
@@ -206,7 +208,11 @@ TEST_CASE("self-collision: detect keeps every pair within reach that a search ov
         double rel = 0;
         for (int p : e1)
           for (int q : e2) rel = std::max(rel, (motion.row(p) - motion.row(q)).norm());
-        const double d = segment_distance(x.row(e1[0]), x.row(e1[1]), x.row(e2[0]), x.row(e2[1]));
+        const Vec3 a0 = x.row(e1[0]), a1 = x.row(e1[1]), b0 = x.row(e2[0]), b1 = x.row(e2[1]);
+        // The boxes' gap is at most the distance: pairs beyond any reach here (< 14 mm) skip the search.
+        const double gap =
+            (b0.cwiseMin(b1) - a0.cwiseMax(a1)).cwiseMax(a0.cwiseMin(a1) - b0.cwiseMax(b1)).cwiseMax(0.0).norm();
+        const double d = gap > 0.02 ? gap : segment_distance(a0, a1, b0, b1);
         count(box_gap({e1[0], e1[1]}, {e2[0], e2[1]}), d, thickness + rel + 2 * slack, ee_sure, ee_maybe);
       }
     sim::SelfCollision sc(m.F, nv);
