@@ -150,6 +150,9 @@ struct SelfCollision::Embree {
   const Points3* motion = nullptr;  // null: boxes of the current positions only
   double pad = 0;
   const SelfCollision* owner = nullptr;
+  // Per kind (vertices, edges, faces): each primitive's box in the last scene built of it,
+  // written by the bounds callbacks.
+  mutable std::vector<RTCBounds> boxes[3];
   ~Embree() {
     if (device) rtcReleaseDevice(device);
   }
@@ -169,12 +172,19 @@ struct SelfCollision::Embree {
     o->upper_y = std::nextafter(static_cast<float>(hi[1]), 1e30f);
     o->upper_z = std::nextafter(static_cast<float>(hi[2]), 1e30f);
   }
-  RTCScene scene(int count, RTCBoundsFunction fn) {
+  // The edges a scene of edges holds: edges_[first, first + count) (primID 0 is edge `first`).
+  struct EdgeRange {
+    const Embree* e;
+    int first;
+  };
+  EdgeRange halves[2] = {};
+  // user: what the bounds callback gets as geometryUserPtr (this Embree by default).
+  RTCScene scene(int count, RTCBoundsFunction fn, void* user = nullptr) {
     RTCScene sc = rtcNewScene(device);
     rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_LOW);
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
     rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(count));
-    rtcSetGeometryUserData(geom, this);
+    rtcSetGeometryUserData(geom, user ? user : this);
     rtcSetGeometryBoundsFunction(geom, fn, nullptr);
     rtcCommitGeometry(geom);
     rtcAttachGeometry(sc, geom);
@@ -191,9 +201,13 @@ struct SelfCollision::Embree {
     bool self;       // both scenes are the same one: keep p < q only
     SpinLock mutex;  // in case Embree calls back from several threads (a pthread mutex was 4% of a simulation)
     std::vector<std::pair<int, int>> pairs;
+    const RTCBounds* box0 = nullptr;  // the primitives' own boxes (Embree::boxes), indexed like primID0 / primID1
+    const RTCBounds* box1 = nullptr;
   };
   // The callback, specialised on the vertex counts of the two kinds: it runs for every box
-  // overlap, an eighth of an HR simulation's time.
+  // overlap, an eighth of an HR simulation's time. Embree also reports some pairs of a BVH leaf
+  // whose own boxes do not overlap (which ones depends on the BVH); they are dropped here, so
+  // the pairs found do not depend on how the primitives are split into scenes.
   template <int N0, int N1> static void gather(void* user, RTCCollision* c, unsigned int n) {
     auto* o = static_cast<Overlaps*>(user);
     std::pair<int, int> keep[256];
@@ -207,6 +221,11 @@ struct SelfCollision::Embree {
       for (int i = 0; i < N0; ++i)
         for (int j = 0; j < N1; ++j) adjacent |= a[i] == b[j];
       if (adjacent) continue;
+      const RTCBounds& ba = o->box0[p];
+      const RTCBounds& bb = o->box1[q];
+      if (ba.lower_x > bb.upper_x || bb.lower_x > ba.upper_x || ba.lower_y > bb.upper_y || bb.lower_y > ba.upper_y ||
+          ba.lower_z > bb.upper_z || bb.lower_z > ba.upper_z)
+        continue;
       if (nk == 256) {
         std::lock_guard<SpinLock> lock(o->mutex);
         o->pairs.insert(o->pairs.end(), keep, keep + nk);
@@ -222,12 +241,18 @@ struct SelfCollision::Embree {
     if (kind == 1) return owner->edges_.empty() ? nullptr : owner->edges_.front().data();
     return kind == 2 ? owner->F_.data() : nullptr;
   }
-  // Overlaps found by the last collide of each pair of kinds (vertex-face, edge-edge,
-  // edge-face): the next one reserves that many, as growing the list was 2.5% of a simulation.
-  size_t last_count[3] = {0, 0, 0};
-  std::vector<std::pair<int, int>> collide(RTCScene a, int ka, RTCScene b, int kb) {
-    Overlaps o{ids(ka), ids(kb), a == b, {}, {}};
-    size_t& last = last_count[ka == 0 ? 0 : kb];  // vertex-face 0, edge-edge 1, edge-face 2
+  // Overlaps found by the last collide of each call site (slot): the next one reserves that
+  // many, as growing the list was 2.5% of a simulation.
+  size_t last_count[5] = {0, 0, 0, 0, 0};
+  // first0 / first1: the id of the scenes' primitive 0 (edge scenes of a range of edges); the
+  // pairs come back in the full ids.
+  std::vector<std::pair<int, int>> collide(RTCScene a, int ka, RTCScene b, int kb, int slot, int first0 = 0,
+                                           int first1 = 0) {
+    if ((ka != 1 && first0 != 0) || (kb != 1 && first1 != 0)) fail("only edge scenes hold a range");
+    Overlaps o{ids(ka) ? ids(ka) + 2 * first0 : nullptr, ids(kb) ? ids(kb) + 2 * first1 : nullptr, a == b, {}, {}};
+    o.box0 = boxes[ka].data() + first0;
+    o.box1 = boxes[kb].data() + first1;
+    size_t& last = last_count[slot];
     o.pairs.reserve(last + last / 8);
     RTCCollideFunc fn = nullptr;
     if (ka == 0 && kb == 2) fn = gather<1, 3>;
@@ -238,13 +263,15 @@ struct SelfCollision::Embree {
     const RTCError err = rtcGetDeviceError(device);
     if (err != RTC_ERROR_NONE) fail("Embree collide failed (error " + std::to_string(static_cast<int>(err)) + ")");
     last = o.pairs.size();
+    if (first0 != 0 || first1 != 0)
+      for (auto& [p, q] : o.pairs) p += first0, q += first1;
     return std::move(o.pairs);  // in callback order: the caller sorts what it keeps
   }
 };
 
 namespace {
 struct ScenesGuard {  // releases the scenes of one broad phase, also when a collide throws
-  RTCScene s[3] = {nullptr, nullptr, nullptr};
+  RTCScene s[4] = {nullptr, nullptr, nullptr, nullptr};
   ~ScenesGuard() {
     for (RTCScene sc : s)
       if (sc) rtcReleaseScene(sc);
@@ -301,11 +328,25 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
   E.motion = &motion;
   E.pad = 0.5 * thickness + slack;
   E.owner = this;
+  E.boxes[0].resize(nv);
+  E.boxes[1].resize(ne);
+  E.boxes[2].resize(nf);
   auto edge_scene = [&] {
     return E.scene(ne, [](const RTCBoundsFunctionArguments* a) {
       const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
       e->bounds(e->owner->edges_[a->primID].data(), 2, a->bounds_o);
+      e->boxes[1][a->primID] = *a->bounds_o;
     });
+  };
+  auto edge_range_scene = [&](Embree::EdgeRange& r, int count) {
+    return E.scene(
+        count,
+        [](const RTCBoundsFunctionArguments* a) {
+          const auto* r = static_cast<const Embree::EdgeRange*>(a->geometryUserPtr);
+          r->e->bounds(r->e->owner->edges_[r->first + a->primID].data(), 2, a->bounds_o);
+          r->e->boxes[1][r->first + a->primID] = *a->bounds_o;
+        },
+        &r);
   };
   auto face_scene = [&] {
     return E.scene(nf, [](const RTCBoundsFunctionArguments* a) {
@@ -313,39 +354,65 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
       const int f = static_cast<int>(a->primID);
       const int ids[3] = {e->owner->F_(f, 0), e->owner->F_(f, 1), e->owner->F_(f, 2)};
       e->bounds(ids, 3, a->bounds_o);
+      e->boxes[2][f] = *a->bounds_o;
     });
   };
   std::vector<std::pair<int, int>> vf, ee, ef;
   {
-    // Vertex-face and edge-edge overlaps on two threads: Embree's device runs one thread
-    // per call, and the broad phase was half of a detection.
+    // Vertex-face and edge-edge overlaps on two threads (Embree's device runs one thread per
+    // call, and the broad phase was half of a detection). The edge-edge overlaps are 2.5x the
+    // work of the vertex-face ones, so the edges are split in halves A and B: one thread
+    // collides vertices with faces and B with B, the other A with A and A with B (each
+    // unordered pair of edges once, as one scene collided with itself would give them).
     ScenesGuard g;
     std::exception_ptr error;
+    const int half = ne / 2;
+    E.halves[0] = {&E, 0};
+    E.halves[1] = {&E, half};
+    std::vector<std::pair<int, int>> ee_bb, ee_ab;
+    auto run = [&](auto&& work) {
+      try {
+        work();
+      } catch (...) {
+#pragma omp critical(self_collision_error)
+        error = std::current_exception();
+      }
+    };
 #pragma omp parallel sections num_threads(2)
     {
 #pragma omp section
-      try {
+      run([&] {
         g.s[0] = E.scene(nv, [](const RTCBoundsFunctionArguments* a) {
           const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
           const int v = static_cast<int>(a->primID);
           e->bounds(&v, 1, a->bounds_o);
+          e->boxes[0][v] = *a->bounds_o;
         });
         g.s[2] = face_scene();
-        vf = E.collide(g.s[0], 0, g.s[2], 2);
-      } catch (...) {
-#pragma omp critical(self_collision_error)
-        error = std::current_exception();
-      }
+      });
 #pragma omp section
-      try {
-        g.s[1] = edge_scene();
-        ee = E.collide(g.s[1], 1, g.s[1], 1);
-      } catch (...) {
-#pragma omp critical(self_collision_error)
-        error = std::current_exception();
-      }
+      run([&] {
+        g.s[1] = edge_range_scene(E.halves[0], half);
+        g.s[3] = edge_range_scene(E.halves[1], ne - half);
+      });
     }
     if (error) std::rethrow_exception(error);
+#pragma omp parallel sections num_threads(2)
+    {
+#pragma omp section
+      run([&] {
+        vf = E.collide(g.s[0], 0, g.s[2], 2, 0);
+        ee_bb = E.collide(g.s[3], 1, g.s[3], 1, 1, half, half);
+      });
+#pragma omp section
+      run([&] {
+        ee = E.collide(g.s[1], 1, g.s[1], 1, 2);
+        ee_ab = E.collide(g.s[1], 1, g.s[3], 1, 3, 0, half);
+      });
+    }
+    if (error) std::rethrow_exception(error);
+    ee.insert(ee.end(), ee_ab.begin(), ee_ab.end());
+    ee.insert(ee.end(), ee_bb.begin(), ee_bb.end());
   }
   if (tangle_test) {
     // An edge crossing a face now: tight boxes of the current positions (the swept, padded
@@ -355,7 +422,7 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     ScenesGuard g;
     g.s[1] = edge_scene();
     g.s[2] = face_scene();
-    ef = E.collide(g.s[1], 1, g.s[2], 2);
+    ef = E.collide(g.s[1], 1, g.s[2], 2, 4);
   }
 
   // Narrow phase (parallel; every candidate writes its own slot, so the result does not

@@ -7,13 +7,10 @@
 // meet before the next detection is found (no tunnelling while each vertex stays within the
 // slack of its predicted path; the solver re-detects as soon as one leaves it). Narrow
 // phase: exact point-triangle and segment-segment distances against the pair's relative
-// motion, so cloth that moves along together does not pay for its speed. Embree's collide
-// also reports some pairs of a BVH leaf whose own boxes do not overlap, and those within reach
-// are kept as well: which ones depends on the BVH (deterministic, built on one thread), so
-// the same boxes in other scenes give other pairs and other results. Splitting the edges into
-// two scenes to balance the two broad-phase threads (edge-edge is 2.5x the vertex-face work;
-// HR skirt_pleated on salsa 61_03 1.28 -> 1.11-1.20 s/frame) kept 1% more edge-edge pairs
-// in the test of tests/gdsr/sim/test_self_collision.cpp, so it is not done.
+// motion, so cloth that moves along together does not pay for its speed. Only pairs whose two
+// boxes overlap are kept (Embree's collide also reports some pairs of a BVH leaf whose own boxes
+// do not, and which ones depended on the BVH), so the edges can be split into two scenes that
+// balance the two broad-phase threads (edge-edge is 2.5x the vertex-face work).
 //
 // Side memory: each pair stores on which side of the triangle (vertex-triangle: sign along
 // the face normal) or of the other edge (edge-edge: the unit separation between the closest

@@ -142,14 +142,12 @@ double segment_distance(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Ve
 }  // namespace
 
 TEST_CASE("self-collision: detect keeps every pair within reach that a search over all pairs finds") {
-  // Two crumpled 20 cm sheets 4 mm apart (random offsets up to 3 mm). Every pair whose two
-  // primitives' path boxes (x to x + motion, grown by thickness / 2 + slack) overlap and whose
-  // distance is below its reach, thickness + relative motion + 2 slack (the header's rule), is
-  // kept; pairs sharing a vertex never. Embree's collide reports some pairs of a leaf whose own
-  // boxes do not overlap, and those within reach are kept too (which ones depends on the BVH:
-  // deterministic, as it is built on one thread), so with motion the count lies between the
-  // overlapping pairs within reach and all pairs within reach. Without motion the two are
-  // the same: every pair closer than thickness + 2 slack, exactly.
+  // Two crumpled 20 cm sheets 4 mm apart (random offsets up to 3 mm), still and with random
+  // motions: detect keeps exactly the non-adjacent pairs whose two primitives' path boxes (x to
+  // x + motion, grown by thickness / 2 + slack) overlap and whose distance is below their reach,
+  // thickness + relative motion + 2 slack (the header's rule); without motion these are all
+  // pairs closer than thickness + 2 slack. The edge-edge pairs come from two scenes of half the
+  // edges each (A x A, A x B, B x B), so this also holds the halves to one scene of all edges.
   auto a = sheet(0.2, 0.01, 0.0), b = sheet(0.2, 0.01, 0.004);
   const auto m = merge(a, b);
   const int nv = static_cast<int>(m.V.rows());
@@ -183,11 +181,11 @@ TEST_CASE("self-collision: detect keeps every pair within reach that a search ov
       }
       return (lo2 - hi1).cwiseMax(lo1 - hi2).cwiseMax(0.0).maxCoeff();
     };
-    // Counts of pairs that must be kept (boxes overlap, within reach) and that may be (within
-    // reach), with room for the float boxes' and the distances' rounding.
+    // Counts of pairs certainly kept and possibly kept (room for the float boxes' and the
+    // distances' rounding).
     auto count = [&](double gap, double d, double reach, int& sure, int& maybe) {
       sure += gap < 2 * pad * (1 - 1e-5) && d < reach * (1 - 1e-9);
-      maybe += d < reach * (1 + 1e-9);
+      maybe += gap < 2 * pad * (1 + 1e-5) && d < reach * (1 + 1e-9);
     };
     int vt_sure = 0, vt_maybe = 0, ee_sure = 0, ee_maybe = 0;
     for (int v = 0; v < nv; ++v)
@@ -221,7 +219,7 @@ TEST_CASE("self-collision: detect keeps every pair within reach that a search ov
                                << sc.num_edge_edge() << " (" << ee_sure << "-" << ee_maybe << ")");
     CHECK(vt_sure > 1000);  // the layers are within reach of each other nearly everywhere
     CHECK(ee_sure > 1000);
-    if (motion.isZero()) CHECK((vt_sure == vt_maybe && ee_sure == ee_maybe));
+
     CHECK(sc.num_vertex_triangle() >= vt_sure);
     CHECK(sc.num_vertex_triangle() <= vt_maybe);
     CHECK(sc.num_edge_edge() >= ee_sure);
