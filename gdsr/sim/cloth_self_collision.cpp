@@ -177,7 +177,7 @@ struct SelfCollision::Embree {
     const Embree* e;
     int first;
   };
-  EdgeRange halves[2] = {};
+  EdgeRange ranges[3] = {};  // all edges, the first half A, the second half B
   // user: what the bounds callback gets as geometryUserPtr (this Embree by default).
   RTCScene scene(int count, RTCBoundsFunction fn, void* user = nullptr) {
     RTCScene sc = rtcNewScene(device);
@@ -331,13 +331,9 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
   E.boxes[0].resize(nv);
   E.boxes[1].resize(ne);
   E.boxes[2].resize(nf);
-  auto edge_scene = [&] {
-    return E.scene(ne, [](const RTCBoundsFunctionArguments* a) {
-      const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
-      e->bounds(e->owner->edges_[a->primID].data(), 2, a->bounds_o);
-      e->boxes[1][a->primID] = *a->bounds_o;
-    });
-  };
+  E.ranges[0] = {&E, 0};
+  E.ranges[1] = {&E, 0};
+  E.ranges[2] = {&E, ne / 2};
   auto edge_range_scene = [&](Embree::EdgeRange& r, int count) {
     return E.scene(
         count,
@@ -367,8 +363,6 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     ScenesGuard g;
     std::exception_ptr error;
     const int half = ne / 2;
-    E.halves[0] = {&E, 0};
-    E.halves[1] = {&E, half};
     std::vector<std::pair<int, int>> ee_bb, ee_ab;
     auto run = [&](auto&& work) {
       try {
@@ -392,8 +386,8 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
       });
 #pragma omp section
       run([&] {
-        g.s[1] = edge_range_scene(E.halves[0], half);
-        g.s[3] = edge_range_scene(E.halves[1], ne - half);
+        g.s[1] = edge_range_scene(E.ranges[1], half);
+        g.s[3] = edge_range_scene(E.ranges[2], ne - half);
       });
     }
     if (error) std::rethrow_exception(error);
@@ -420,7 +414,7 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     E.motion = nullptr;
     E.pad = 0;
     ScenesGuard g;
-    g.s[1] = edge_scene();
+    g.s[1] = edge_range_scene(E.ranges[0], ne);
     g.s[2] = face_scene();
     ef = E.collide(g.s[1], 1, g.s[2], 2, 4);
   }
