@@ -177,7 +177,10 @@ struct SelfCollision::Embree {
     const Embree* e;
     int first;
   };
-  EdgeRange ranges[3] = {};  // all edges, the first half A, the second half B
+  // The edges are collided with each other in kEdgeChunks scenes of consecutive edges, so that
+  // the pairs of chunks (and the vertex-face pairs) are jobs the two threads can share out.
+  static constexpr int kEdgeChunks = 8;
+  EdgeRange ranges[kEdgeChunks + 1] = {};  // all edges, then the chunks
   // user: what the bounds callback gets as geometryUserPtr (this Embree by default).
   RTCScene scene(int count, RTCBoundsFunction fn, void* user = nullptr) {
     RTCScene sc = rtcNewScene(device);
@@ -192,25 +195,30 @@ struct SelfCollision::Embree {
     rtcCommitScene(sc);
     return sc;
   }
-  // Box overlaps (primID0, primID1) between two scenes of the given kinds (0 vertices,
-  // 1 edges, 2 faces) whose primitives share no vertex, each unordered pair once, in no
-  // particular order. Two collides may run at once (each has its own Overlaps).
-  struct Overlaps {
+  // Pairs of primitives (primID0, primID1) of two scenes of the given kinds (0 vertices,
+  // 1 edges, 2 faces) whose boxes overlap and which share no vertex, each unordered pair
+  // once, given to the narrow phase as soon as Embree reports them, so the many pairs it
+  // rejects are never stored (storing them and reading them back was a fifth of a detection).
+  // Two collides may run at once (each has its own Overlaps).
+  template <class Out> struct Overlaps {
+    const SelfCollision* sc;
     const int* ids0;  // vertex ids of the primitives, n0 per primitive (null for vertices: the id itself)
     const int* ids1;
-    bool self;       // both scenes are the same one: keep p < q only
+    int first0, first1;     // full id of the scenes' primitive 0 (edge scenes of a range of edges)
+    bool self;              // both scenes are the same one: keep p < q only
+    const RTCBounds* box0;  // the primitives' own boxes (Embree::boxes), indexed like primID0 / primID1
+    const RTCBounds* box1;
+    const Narrow* narrow;
     SpinLock mutex;  // in case Embree calls back from several threads (a pthread mutex was 4% of a simulation)
-    std::vector<std::pair<int, int>> pairs;
-    const RTCBounds* box0 = nullptr;  // the primitives' own boxes (Embree::boxes), indexed like primID0 / primID1
-    const RTCBounds* box1 = nullptr;
+    std::vector<Out> kept;
   };
   // The callback, specialised on the vertex counts of the two kinds: it runs for every box
-  // overlap, an eighth of an HR simulation's time. Embree also reports some pairs of a BVH leaf
-  // whose own boxes do not overlap (which ones depends on the BVH); they are dropped here, so
-  // the pairs found do not depend on how the primitives are split into scenes.
-  template <int N0, int N1> static void gather(void* user, RTCCollision* c, unsigned int n) {
-    auto* o = static_cast<Overlaps*>(user);
-    std::pair<int, int> keep[256];
+  // overlap. Embree also reports some pairs of a BVH leaf whose own boxes do not overlap
+  // (which ones depends on the BVH); they are dropped here, so the pairs found do not depend
+  // on how the primitives are split into scenes.
+  template <int N0, int N1, class Out> static void gather(void* user, RTCCollision* c, unsigned int n) {
+    auto* o = static_cast<Overlaps<Out>*>(user);
+    Out keep[64];
     int nk = 0;
     for (unsigned k = 0; k < n; ++k) {
       const int p = static_cast<int>(c[k].primID0), q = static_cast<int>(c[k].primID1);
@@ -226,52 +234,76 @@ struct SelfCollision::Embree {
       if (ba.lower_x > bb.upper_x || bb.lower_x > ba.upper_x || ba.lower_y > bb.upper_y || bb.lower_y > ba.upper_y ||
           ba.lower_z > bb.upper_z || bb.lower_z > ba.upper_z)
         continue;
-      if (nk == 256) {
+      if (!o->sc->narrow_phase(*o->narrow, p + o->first0, q + o->first1, keep[nk])) continue;
+      if (++nk == 64) {
         std::lock_guard<SpinLock> lock(o->mutex);
-        o->pairs.insert(o->pairs.end(), keep, keep + nk);
+        o->kept.insert(o->kept.end(), keep, keep + nk);
         nk = 0;
       }
-      keep[nk++] = {p, q};
     }
     std::lock_guard<SpinLock> lock(o->mutex);
-    o->pairs.insert(o->pairs.end(), keep, keep + nk);
+    o->kept.insert(o->kept.end(), keep, keep + nk);
   }
   const int* ids(int kind) const {
     static_assert(sizeof(std::array<int, 2>) == 2 * sizeof(int), "edges_ is read as a flat array of vertex ids");
     if (kind == 1) return owner->edges_.empty() ? nullptr : owner->edges_.front().data();
     return kind == 2 ? owner->F_.data() : nullptr;
   }
-  // Overlaps found by the last collide of each call site (slot): the next one reserves that
+  // Pairs kept by the last collide of each call site (slot): the next one reserves that
   // many, as growing the list was 2.5% of a simulation.
-  size_t last_count[5] = {0, 0, 0, 0, 0};
-  // first0 / first1: the id of the scenes' primitive 0 (edge scenes of a range of edges); the
-  // pairs come back in the full ids.
-  std::vector<std::pair<int, int>> collide(RTCScene a, int ka, RTCScene b, int kb, int slot, int first0 = 0,
-                                           int first1 = 0) {
+  static constexpr int kSlots = 2 + kEdgeChunks * (kEdgeChunks + 1) / 2;  // vertex-face, chunk pairs, tangle
+  size_t last_count[kSlots] = {};
+  // The narrow phase's survivors among the overlaps of scenes a (kind ka) and b (kind kb), in
+  // callback order (the caller sorts them). Out: VT (vertices x faces), EE (edges x edges) or
+  // (edge, face) crossings (std::array<int, 2>). first0 / first1: the id of the scenes' primitive 0.
+  template <class Out> std::vector<Out> collide(RTCScene a, int ka, RTCScene b, int kb, int slot, const Narrow& narrow,
+                                                int first0 = 0, int first1 = 0) {
     if ((ka != 1 && first0 != 0) || (kb != 1 && first1 != 0)) fail("only edge scenes hold a range");
-    Overlaps o{ids(ka) ? ids(ka) + 2 * first0 : nullptr, ids(kb) ? ids(kb) + 2 * first1 : nullptr, a == b, {}, {}};
-    o.box0 = boxes[ka].data() + first0;
-    o.box1 = boxes[kb].data() + first1;
+    Overlaps<Out> o{owner,
+                    ids(ka) ? ids(ka) + 2 * first0 : nullptr,
+                    ids(kb) ? ids(kb) + 2 * first1 : nullptr,
+                    first0,
+                    first1,
+                    a == b,
+                    boxes[ka].data() + first0,
+                    boxes[kb].data() + first1,
+                    &narrow,
+                    {},
+                    {}};
     size_t& last = last_count[slot];
-    o.pairs.reserve(last + last / 8);
+    o.kept.reserve(last + last / 8);
     RTCCollideFunc fn = nullptr;
-    if (ka == 0 && kb == 2) fn = gather<1, 3>;
-    if (ka == 1 && kb == 1) fn = gather<2, 2>;
-    if (ka == 1 && kb == 2) fn = gather<2, 3>;
+    if (ka == 0 && kb == 2) fn = gather<1, 3, Out>;
+    if (ka == 1 && kb == 1) fn = gather<2, 2, Out>;
+    if (ka == 1 && kb == 2) fn = gather<2, 3, Out>;
     if (!fn) fail("no collide callback for these primitive kinds");
     rtcCollide(a, b, fn, &o);
     const RTCError err = rtcGetDeviceError(device);
     if (err != RTC_ERROR_NONE) fail("Embree collide failed (error " + std::to_string(static_cast<int>(err)) + ")");
-    last = o.pairs.size();
-    if (first0 != 0 || first1 != 0)
-      for (auto& [p, q] : o.pairs) p += first0, q += first1;
-    return std::move(o.pairs);  // in callback order: the caller sorts what it keeps
+    last = o.kept.size();
+    return std::move(o.kept);
   }
 };
 
 namespace {
+// Runs job(0) .. job(n - 1) on two threads, each job taken by the first thread free (the
+// largest first, if the caller lists them so); rethrows the first exception a job threw.
+template <class Job> void run_jobs(int n, Job&& job) {
+  std::exception_ptr error;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(2)
+  for (int k = 0; k < n; ++k) {
+    try {
+      job(k);
+    } catch (...) {
+#pragma omp critical(self_collision_error)
+      error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
+}
+
 struct ScenesGuard {  // releases the scenes of one broad phase, also when a collide throws
-  RTCScene s[4] = {nullptr, nullptr, nullptr, nullptr};
+  RTCScene s[16] = {};
   ~ScenesGuard() {
     for (RTCScene sc : s)
       if (sc) rtcReleaseScene(sc);
@@ -331,9 +363,11 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
   E.boxes[0].resize(nv);
   E.boxes[1].resize(ne);
   E.boxes[2].resize(nf);
+  constexpr int K = Embree::kEdgeChunks;
+  int first[K + 1];  // chunk c holds edges [first[c], first[c + 1])
+  for (int c = 0; c <= K; ++c) first[c] = static_cast<int>(static_cast<long long>(ne) * c / K);
   E.ranges[0] = {&E, 0};
-  E.ranges[1] = {&E, 0};
-  E.ranges[2] = {&E, ne / 2};
+  for (int c = 0; c < K; ++c) E.ranges[c + 1] = {&E, first[c]};
   auto edge_range_scene = [&](Embree::EdgeRange& r, int count) {
     return E.scene(
         count,
@@ -353,60 +387,59 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
       e->boxes[2][f] = *a->bounds_o;
     });
   };
-  std::vector<std::pair<int, int>> vf, ee, ef;
+  // The narrow phase runs inside the collides' callbacks, each pair on its own, so what is
+  // kept does not depend on which thread found it; the kept pairs are sorted afterwards.
+  const Narrow narrow{&x, &motion, slack, thickness};
   {
-    // Vertex-face and edge-edge overlaps on two threads (Embree's device runs one thread per
-    // call, and the broad phase was half of a detection). The edge-edge overlaps are 2.5x the
-    // work of the vertex-face ones, so the edges are split in halves A and B: one thread
-    // collides vertices with faces and B with B, the other A with A and A with B (each
-    // unordered pair of edges once, as one scene collided with itself would give them).
-    ScenesGuard g;
-    std::exception_ptr error;
-    const int half = ne / 2;
-    std::vector<std::pair<int, int>> ee_bb, ee_ab;
-    auto run = [&](auto&& work) {
-      try {
-        work();
-      } catch (...) {
-#pragma omp critical(self_collision_error)
-        error = std::current_exception();
-      }
-    };
-#pragma omp parallel sections num_threads(2)
-    {
-#pragma omp section
-      run([&] {
+    // Vertex-face and edge-edge pairs on two threads (Embree's device runs one thread per
+    // call), as jobs taken in turn: the vertex-face pairs, then every pair of edge chunks
+    // (each unordered pair of edges once, as one scene collided with itself would give them),
+    // the largest jobs first. Edge-edge pairs are 2.5x the work of vertex-face ones.
+    ScenesGuard g;  // s[0] vertices, s[1] faces, s[2 + c] edge chunk c
+    static_assert(2 + K <= static_cast<int>(sizeof(g.s) / sizeof(g.s[0])), "one scene per edge chunk");
+    run_jobs(2 + K, [&](int k) {
+      if (k == 0)
         g.s[0] = E.scene(nv, [](const RTCBoundsFunctionArguments* a) {
           const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
           const int v = static_cast<int>(a->primID);
           e->bounds(&v, 1, a->bounds_o);
           e->boxes[0][v] = *a->bounds_o;
         });
-        g.s[2] = face_scene();
-      });
-#pragma omp section
-      run([&] {
-        g.s[1] = edge_range_scene(E.ranges[1], half);
-        g.s[3] = edge_range_scene(E.ranges[2], ne - half);
-      });
-    }
-    if (error) std::rethrow_exception(error);
+      else if (k == 1)
+        g.s[1] = face_scene();
+      else
+        g.s[k] = edge_range_scene(E.ranges[k - 1], first[k - 1] - first[k - 2]);
+    });
+    std::vector<std::array<int, 2>> jobs = {{-1, -1}};             // (-1, -1): vertex-face; (c, d): edge chunks c <= d
+    auto empty = [&](int c) { return first[c + 1] == first[c]; };  // (Embree's collide crashed on an empty scene)
+    for (int c = 0; c < K; ++c)
+      for (int d = c + 1; d < K; ++d)
+        if (!empty(c) && !empty(d)) jobs.push_back({c, d});
+    for (int c = 0; c < K; ++c)
+      if (!empty(c)) jobs.push_back({c, c});
+    const int njobs = static_cast<int>(jobs.size());
+    std::vector<std::vector<EE>> ee_parts(jobs.size());
+    run_jobs(njobs, [&](int k) {
+      const auto [c, d] = jobs[k];
+      if (c < 0)
+        vt_ = E.collide<VT>(g.s[0], 0, g.s[1], 2, 0, narrow);
+      else
+        ee_parts[k] = E.collide<EE>(g.s[2 + c], 1, g.s[2 + d], 1, k, narrow, first[c], first[d]);
+    });
+    size_t total = 0;
+    for (const auto& part : ee_parts) total += part.size();
+    ee_.reserve(total);
+    for (const auto& part : ee_parts) ee_.insert(ee_.end(), part.begin(), part.end());
+  }
+  // Kept pairs in a fixed order (the broad phase's order is not).
 #pragma omp parallel sections num_threads(2)
-    {
+  {
 #pragma omp section
-      run([&] {
-        vf = E.collide(g.s[0], 0, g.s[2], 2, 0);
-        ee_bb = E.collide(g.s[3], 1, g.s[3], 1, 1, half, half);
-      });
+    sort_unique_pairs(
+        vt_, nv, [](const VT& c) { return c.v; }, [](const VT& c) { return c.f; });
 #pragma omp section
-      run([&] {
-        ee = E.collide(g.s[1], 1, g.s[1], 1, 2);
-        ee_ab = E.collide(g.s[1], 1, g.s[3], 1, 3, 0, half);
-      });
-    }
-    if (error) std::rethrow_exception(error);
-    ee.insert(ee.end(), ee_ab.begin(), ee_ab.end());
-    ee.insert(ee.end(), ee_bb.begin(), ee_bb.end());
+    sort_unique_pairs(
+        ee_, ne, [](const EE& c) { return c.a; }, [](const EE& c) { return c.b; });
   }
   if (tangle_test) {
     // An edge crossing a face now: tight boxes of the current positions (the swept, padded
@@ -416,84 +449,63 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     ScenesGuard g;
     g.s[1] = edge_range_scene(E.ranges[0], ne);
     g.s[2] = face_scene();
-    ef = E.collide(g.s[1], 1, g.s[2], 2, 4);
-  }
-
-  // Narrow phase (parallel; every candidate writes its own slot, so the result does not
-  // depend on the thread count).
-  std::vector<signed char> vt_keep(vf.size(), 0), ee_keep(ee.size(), 0), ef_cross(ef.size(), 0);
-  std::vector<float> vt_reach(vf.size()), ee_reach(ee.size());  // see VT::reach
-  std::vector<std::array<float, 3>> ee_dir(ee.size());
-  const int nvf = static_cast<int>(vf.size()), nee = static_cast<int>(ee.size()), nef = static_cast<int>(ef.size());
-#pragma omp parallel
-  {
-#pragma omp for schedule(static) nowait
-    for (int k = 0; k < nvf; ++k) {
-      const int v = vf[k].first, g = vf[k].second;
-      const Vec3 p = x.row(v), a = x.row(F_(g, 0)), b = x.row(F_(g, 1)), c = x.row(F_(g, 2));
-      // Relative motion of the vertex against any point of the triangle is bounded by the
-      // largest against its corners; each side may also leave its path by `slack`.
-      double rel2 = 0;
-      for (int i = 0; i < 3; ++i) rel2 = std::max(rel2, (motion.row(v) - motion.row(F_(g, i))).squaredNorm());
-      const double rel = std::sqrt(rel2), reach = thickness + rel + 2 * slack;
-      if (box_gap2(p, p, a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c)) > reach * reach * kGapMargin) continue;
-      const double d = (p - gdsr::closest_point_on_triangle(p, a, b, c).point).norm();
-      if (d >= reach) continue;
-      Vec3 bary, n;
-      double dist = 0;
-      if (!project_on_triangle(p, a, b, c, bary, n, dist)) continue;
-      vt_keep[k] = dist >= 0 ? 1 : -1;
-      vt_reach[k] = static_cast<float>(reach);
-    }
-#pragma omp for schedule(static) nowait
-    for (int k = 0; k < nee; ++k) {
-      const int ea = ee[k].first, eb = ee[k].second;
-      const int i0 = edges_[ea][0], i1 = edges_[ea][1], j0 = edges_[eb][0], j1 = edges_[eb][1];
-      const Vec3 p1 = x.row(i0), q1 = x.row(i1), p2 = x.row(j0), q2 = x.row(j1);
-      double rel2 = 0;
-      for (int u : edges_[ea])
-        for (int w : edges_[eb]) rel2 = std::max(rel2, (motion.row(u) - motion.row(w)).squaredNorm());
-      const double rel = std::sqrt(rel2), reach = thickness + rel + 2 * slack;
-      if (box_gap2(p1.cwiseMin(q1), p1.cwiseMax(q1), p2.cwiseMin(q2), p2.cwiseMax(q2)) > reach * reach * kGapMargin)
-        continue;
-      double s = 0, t = 0;
-      closest_segments(p1, q1, p2, q2, s, t);
-      const Vec3 d = (p1 + s * (q1 - p1)) - (p2 + t * (q2 - p2));
-      const double len = d.norm();
-      if (len >= reach) continue;
-      ee_keep[k] = 1;
-      ee_reach[k] = static_cast<float>(reach);
-      const Vec3 u = len > 0 ? Vec3(d / len) : Vec3::Zero();
-      ee_dir[k] = {static_cast<float>(u.x()), static_cast<float>(u.y()), static_cast<float>(u.z())};
-    }
-#pragma omp for schedule(static)
-    for (int k = 0; k < nef; ++k) {  // tangle test: an edge crossing a face
-      const int e = ef[k].first, f = ef[k].second;
-      ef_cross[k] = segment_crosses_triangle(x.row(edges_[e][0]), x.row(edges_[e][1]), x.row(F_(f, 0)), x.row(F_(f, 1)),
-                                             x.row(F_(f, 2)));
-    }
-  }
-  // Kept pairs in a fixed order (the broad phase's order is not).
-  for (int k = 0; k < nvf; ++k)
-    if (vt_keep[k]) vt_.push_back({vf[k].first, vf[k].second, vt_keep[k], vt_reach[k]});
-  for (int k = 0; k < nee; ++k)
-    if (ee_keep[k]) ee_.push_back({ee[k].first, ee[k].second, {ee_dir[k][0], ee_dir[k][1], ee_dir[k][2]}, ee_reach[k]});
-#pragma omp parallel sections num_threads(2)
-  {
-#pragma omp section
-    sort_unique_pairs(vt_, nv, [](const VT& c) { return c.v; }, [](const VT& c) { return c.f; });
-#pragma omp section
-    sort_unique_pairs(ee_, ne, [](const EE& c) { return c.a; }, [](const EE& c) { return c.b; });
-  }
-  for (int k = 0; k < nef; ++k)
-    if (ef_cross[k]) {
-      ++intersecting_;
-      const int e = ef[k].first, f = ef[k].second;
-      crossings_.push_back({e, f});
+    crossings_ = E.collide<std::array<int, 2>>(g.s[1], 1, g.s[2], 2, Embree::kSlots - 1, narrow);
+    std::sort(crossings_.begin(), crossings_.end());  // the broad phase's order is not fixed
+    intersecting_ = static_cast<int>(crossings_.size());
+    for (const auto& [e, f] : crossings_) {
       tangled_[edges_[e][0]] = tangled_[edges_[e][1]] = 1;
       for (int i = 0; i < 3; ++i) tangled_[F_(f, i)] = 1;
     }
-  std::sort(crossings_.begin(), crossings_.end());  // the broad phase's order is not fixed
+  }
+}
+
+bool SelfCollision::narrow_phase(const Narrow& n, int v, int g, VT& out) const {
+  const Points3 &x = *n.x, &motion = *n.motion;
+  const Vec3 p = x.row(v), a = x.row(F_(g, 0)), b = x.row(F_(g, 1)), c = x.row(F_(g, 2));
+  // Relative motion of the vertex against any point of the triangle is bounded by the
+  // largest against its corners; each side may also leave its path by `slack`.
+  double rel2 = 0;
+  for (int i = 0; i < 3; ++i) rel2 = std::max(rel2, (motion.row(v) - motion.row(F_(g, i))).squaredNorm());
+  const double rel = std::sqrt(rel2), reach = n.thickness + rel + 2 * n.slack;
+  if (box_gap2(p, p, a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c)) > reach * reach * kGapMargin) return false;
+  const double d = (p - gdsr::closest_point_on_triangle(p, a, b, c).point).norm();
+  if (d >= reach) return false;
+  Vec3 bary, nrm;
+  double dist = 0;
+  if (!project_on_triangle(p, a, b, c, bary, nrm, dist)) return false;
+  out = {v, g, static_cast<signed char>(dist >= 0 ? 1 : -1), static_cast<float>(reach)};
+  return true;
+}
+
+bool SelfCollision::narrow_phase(const Narrow& n, int ea, int eb, EE& out) const {
+  const Points3 &x = *n.x, &motion = *n.motion;
+  const int i0 = edges_[ea][0], i1 = edges_[ea][1], j0 = edges_[eb][0], j1 = edges_[eb][1];
+  const Vec3 p1 = x.row(i0), q1 = x.row(i1), p2 = x.row(j0), q2 = x.row(j1);
+  double rel2 = 0;
+  for (int u : edges_[ea])
+    for (int w : edges_[eb]) rel2 = std::max(rel2, (motion.row(u) - motion.row(w)).squaredNorm());
+  const double rel = std::sqrt(rel2), reach = n.thickness + rel + 2 * n.slack;
+  if (box_gap2(p1.cwiseMin(q1), p1.cwiseMax(q1), p2.cwiseMin(q2), p2.cwiseMax(q2)) > reach * reach * kGapMargin)
+    return false;
+  double s = 0, t = 0;
+  closest_segments(p1, q1, p2, q2, s, t);
+  const Vec3 d = (p1 + s * (q1 - p1)) - (p2 + t * (q2 - p2));
+  const double len = d.norm();
+  if (len >= reach) return false;
+  out.a = ea;
+  out.b = eb;
+  out.set_dir(len > 0 ? Vec3(d / len) : Vec3::Zero());
+  out.reach = static_cast<float>(reach);
+  return true;
+}
+
+bool SelfCollision::narrow_phase(const Narrow& n, int e, int f, std::array<int, 2>& out) const {
+  const Points3& x = *n.x;
+  if (!segment_crosses_triangle(x.row(edges_[e][0]), x.row(edges_[e][1]), x.row(F_(f, 0)), x.row(F_(f, 1)),
+                                x.row(F_(f, 2))))
+    return false;
+  out = {e, f};
+  return true;
 }
 
 int SelfCollision::untangle(Points3& x, const std::vector<double>& winv, double step) {

@@ -9,8 +9,9 @@
 // phase: exact point-triangle and segment-segment distances against the pair's relative
 // motion, so cloth that moves along together does not pay for its speed. Only pairs whose two
 // boxes overlap are kept (Embree's collide also reports some pairs of a BVH leaf whose own boxes
-// do not, and which ones depended on the BVH), so the edges can be split into two scenes that
-// balance the two broad-phase threads (edge-edge is 2.5x the vertex-face work).
+// do not, and which ones depended on the BVH), so the edges can be split into chunks whose pairs
+// are jobs for the two threads; the narrow phase runs inside Embree's callbacks, so only the
+// pairs it keeps are stored.
 //
 // Side memory: each pair stores on which side of the triangle (vertex-triangle: sign along
 // the face normal) or of the other edge (edge-edge: the unit separation between the closest
@@ -103,6 +104,17 @@ class SelfCollision {
       dir[0] = static_cast<float>(u.x()), dir[1] = static_cast<float>(u.y()), dir[2] = static_cast<float>(u.z());
     }
   };
+  // Per detection: what the narrow phase tests the broad phase's pairs against.
+  struct Narrow {
+    const gdsr::Points3* x;
+    const gdsr::Points3* motion;
+    double slack, thickness;
+  };
+  // Narrow phase of one pair: true (and `out` filled) if it is kept. Vertex v and face f
+  // within reach (VT), edges a < b within reach (EE), edge e crossing face f (tangle test).
+  bool narrow_phase(const Narrow& n, int v, int f, VT& out) const;
+  bool narrow_phase(const Narrow& n, int a, int b, EE& out) const;
+  bool narrow_phase(const Narrow& n, int e, int f, std::array<int, 2>& out) const;
   gdsr::Faces F_;
   std::vector<std::array<int, 2>> edges_;  // unique edges (i < j)
   std::vector<std::array<int, 2>> edge_faces_;  // the (one or two) faces of each edge, -1: none

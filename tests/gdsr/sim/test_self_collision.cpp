@@ -146,8 +146,8 @@ TEST_CASE("self-collision: detect keeps every pair within reach that a search ov
   // motions: detect keeps exactly the non-adjacent pairs whose two primitives' path boxes (x to
   // x + motion, grown by thickness / 2 + slack) overlap and whose distance is below their reach,
   // thickness + relative motion + 2 slack (the header's rule); without motion these are all
-  // pairs closer than thickness + 2 slack. The edge-edge pairs come from two scenes of half the
-  // edges each (A x A, A x B, B x B), so this also holds the halves to one scene of all edges.
+  // pairs closer than thickness + 2 slack. The edge-edge pairs come from every pair of several
+  // scenes (chunks) of consecutive edges, so this also holds the chunks to one scene of all edges.
   auto a = sheet(0.2, 0.01, 0.0), b = sheet(0.2, 0.01, 0.004);
   const auto m = merge(a, b);
   const int nv = static_cast<int>(m.V.rows());
