@@ -152,7 +152,13 @@ struct SelfCollision::Embree {
   const SelfCollision* owner = nullptr;
   // Per kind (vertices, edges, faces): each primitive's box in the last scene built of it,
   // written by the bounds callbacks.
-  mutable std::vector<RTCBounds> boxes[3];
+  // Each primitive's box beside its vertex ids (one, two or three), read together for each pair
+  // Embree reports.
+  struct Prim {
+    RTCBounds box;
+    int v[3];
+  };
+  mutable std::vector<Prim> prims[3];
   ~Embree() {
     if (device) rtcReleaseDevice(device);
   }
@@ -202,12 +208,10 @@ struct SelfCollision::Embree {
   // Two collides may run at once (each has its own Overlaps).
   template <class Out> struct Overlaps {
     const SelfCollision* sc;
-    const int* ids0;  // vertex ids of the primitives, n0 per primitive (null for vertices: the id itself)
-    const int* ids1;
     int first0, first1;     // full id of the scenes' primitive 0 (edge scenes of a range of edges)
     bool self;              // both scenes are the same one: keep p < q only
-    const RTCBounds* box0;  // the primitives' own boxes (Embree::boxes), indexed like primID0 / primID1
-    const RTCBounds* box1;
+    const Prim* prim0;      // the scenes' primitives (Embree::prims), indexed like primID0 / primID1
+    const Prim* prim1;
     const Narrow* narrow;
     SpinLock mutex;  // in case Embree calls back from several threads (a pthread mutex was 4% of a simulation)
     std::vector<Out> kept;
@@ -223,14 +227,14 @@ struct SelfCollision::Embree {
     for (unsigned k = 0; k < n; ++k) {
       const int p = static_cast<int>(c[k].primID0), q = static_cast<int>(c[k].primID1);
       if (o->self && p >= q) continue;
-      const int* a = N0 == 1 ? &p : o->ids0 + static_cast<size_t>(N0) * p;
-      const int* b = N1 == 1 ? &q : o->ids1 + static_cast<size_t>(N1) * q;
+      const Prim& pa = o->prim0[p];
+      const Prim& pb = o->prim1[q];
       bool adjacent = false;
       for (int i = 0; i < N0; ++i)
-        for (int j = 0; j < N1; ++j) adjacent |= a[i] == b[j];
+        for (int j = 0; j < N1; ++j) adjacent |= pa.v[i] == pb.v[j];
       if (adjacent) continue;
-      const RTCBounds& ba = o->box0[p];
-      const RTCBounds& bb = o->box1[q];
+      const RTCBounds& ba = pa.box;
+      const RTCBounds& bb = pb.box;
       if (ba.lower_x > bb.upper_x || bb.lower_x > ba.upper_x || ba.lower_y > bb.upper_y || bb.lower_y > ba.upper_y ||
           ba.lower_z > bb.upper_z || bb.lower_z > ba.upper_z)
         continue;
@@ -244,11 +248,6 @@ struct SelfCollision::Embree {
     std::lock_guard<SpinLock> lock(o->mutex);
     o->kept.insert(o->kept.end(), keep, keep + nk);
   }
-  const int* ids(int kind) const {
-    static_assert(sizeof(std::array<int, 2>) == 2 * sizeof(int), "edges_ is read as a flat array of vertex ids");
-    if (kind == 1) return owner->edges_.empty() ? nullptr : owner->edges_.front().data();
-    return kind == 2 ? owner->F_.data() : nullptr;
-  }
   // Pairs kept by the last collide of each call site (slot): the next one reserves that
   // many, as growing the list was 2.5% of a simulation.
   static constexpr int kSlots = 2 + kEdgeChunks * (kEdgeChunks + 1) / 2;  // vertex-face, chunk pairs, tangle
@@ -259,17 +258,8 @@ struct SelfCollision::Embree {
   template <class Out> std::vector<Out> collide(RTCScene a, int ka, RTCScene b, int kb, int slot, const Narrow& narrow,
                                                 int first0 = 0, int first1 = 0) {
     if ((ka != 1 && first0 != 0) || (kb != 1 && first1 != 0)) fail("only edge scenes hold a range");
-    Overlaps<Out> o{owner,
-                    ids(ka) ? ids(ka) + 2 * first0 : nullptr,
-                    ids(kb) ? ids(kb) + 2 * first1 : nullptr,
-                    first0,
-                    first1,
-                    a == b,
-                    boxes[ka].data() + first0,
-                    boxes[kb].data() + first1,
-                    &narrow,
-                    {},
-                    {}};
+    Overlaps<Out> o{owner,   first0, first1, a == b, prims[ka].data() + first0, prims[kb].data() + first1,
+                    &narrow, {},     {}};
     size_t& last = last_count[slot];
     o.kept.reserve(last + last / 8);
     RTCCollideFunc fn = nullptr;
@@ -360,9 +350,9 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
   E.motion = &motion;
   E.pad = 0.5 * thickness + slack;
   E.owner = this;
-  E.boxes[0].resize(nv);
-  E.boxes[1].resize(ne);
-  E.boxes[2].resize(nf);
+  E.prims[0].resize(nv);
+  E.prims[1].resize(ne);
+  E.prims[2].resize(nf);
   constexpr int K = Embree::kEdgeChunks;
   int first[K + 1];  // chunk c holds edges [first[c], first[c + 1])
   for (int c = 0; c <= K; ++c) first[c] = static_cast<int>(static_cast<long long>(ne) * c / K);
@@ -373,8 +363,10 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
         count,
         [](const RTCBoundsFunctionArguments* a) {
           const auto* r = static_cast<const Embree::EdgeRange*>(a->geometryUserPtr);
-          r->e->bounds(r->e->owner->edges_[r->first + a->primID].data(), 2, a->bounds_o);
-          r->e->boxes[1][r->first + a->primID] = *a->bounds_o;
+          const int id = r->first + static_cast<int>(a->primID);
+          const auto& ends = r->e->owner->edges_[id];
+          r->e->bounds(ends.data(), 2, a->bounds_o);
+          r->e->prims[1][id] = {*a->bounds_o, {ends[0], ends[1], -1}};
         },
         &r);
   };
@@ -384,7 +376,7 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
       const int f = static_cast<int>(a->primID);
       const int ids[3] = {e->owner->F_(f, 0), e->owner->F_(f, 1), e->owner->F_(f, 2)};
       e->bounds(ids, 3, a->bounds_o);
-      e->boxes[2][f] = *a->bounds_o;
+      e->prims[2][f] = {*a->bounds_o, {ids[0], ids[1], ids[2]}};
     });
   };
   // The narrow phase runs inside the collides' callbacks, each pair on its own, so what is
@@ -403,7 +395,7 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
           const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
           const int v = static_cast<int>(a->primID);
           e->bounds(&v, 1, a->bounds_o);
-          e->boxes[0][v] = *a->bounds_o;
+          e->prims[0][v] = {*a->bounds_o, {v, -1, -1}};
         });
       else if (k == 1)
         g.s[1] = face_scene();
