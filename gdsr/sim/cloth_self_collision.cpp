@@ -151,9 +151,8 @@ struct SelfCollision::Embree {
   double pad = 0;
   const SelfCollision* owner = nullptr;
   // Per kind (vertices, edges, faces): each primitive's box in the last scene built of it,
-  // written by the bounds callbacks.
-  // Each primitive's box beside its vertex ids (one, two or three), read together for each pair
-  // Embree reports.
+  // written by the bounds callbacks, beside its vertex ids (one, two or three; -1 for none), so
+  // the callback reads one record per side of each pair Embree reports.
   struct Prim {
     RTCBounds box;
     int v[3];
