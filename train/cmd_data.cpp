@@ -70,6 +70,7 @@ struct MakeArgs {
   bool self_collision = true;
   bool limbs_pass_through = true;
   bool limbs_pass_until_clear = true;
+  bool self_redetect = true;
   bool independent_hr = false;  // settle HR from its own placement, not from the settled LR garment
   bool skip_built = false;      // keep --out when it already holds this clip, built and valid
   int rest_blend_frames = 15;
@@ -205,6 +206,7 @@ void run_make(const MakeArgs& a) {
   params.self_collision = a.self_collision;
   params.limbs_pass_through = a.limbs_pass_through;
   params.limbs_pass_until_clear = a.limbs_pass_until_clear;
+  params.self_redetect = a.self_redetect;
   sim::Garment lr_garment = sim::make_garment(a.garment, a.lr_pd, body.rest_mesh());
   sim::Garment hr_garment = sim::make_garment(a.garment, a.hr_pd, body.rest_mesh());
   gdsr::Dataset d;
@@ -264,6 +266,7 @@ void run_make(const MakeArgs& a) {
                   {"self_detect_every", params.self_detect_every},
                   {"self_passes", params.self_passes},
                   {"self_crossed_push", params.self_crossed_push},
+                  {"self_redetect", params.self_redetect},
                   {"untangle_step", params.untangle_step},
                   {"hr_track_rate_1_s", params.track_rate},
                   {"compression_ratio", params.compression_ratio},
@@ -690,6 +693,9 @@ void add_data_command(CLI::App& app) {
                    "frames of damped motion on the first pose before frame 0 (default: the solver's)")
       ->check(CLI::Range(0, 1000));
   make->add_flag("!--no-self-collision", mk->self_collision, "switch cloth self-collision off");
+  make->add_flag("!--no-self-redetect", mk->self_redetect,
+                 "find every self-contact pair again whenever a vertex leaves its slack, not only that vertex's "
+                 "(solver revision 21; slower, the same pairs where it matters)");
   make->add_flag("!--no-limbs-pass-through", mk->limbs_pass_through,
                  "keep body contacts around cloth that a hand went through, so the hand carries it (solver "
                  "revision 10)");

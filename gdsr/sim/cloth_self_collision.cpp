@@ -158,7 +158,17 @@ struct SelfCollision::Embree {
     int v[3];
   };
   mutable std::vector<Prim> prims[3];
+  // The scenes of the last detect (vertices, faces, then the edge chunks), kept for redetect:
+  // their boxes still bound the paths of every primitive no vertex of which has moved since.
+  static constexpr int kEdgeChunks = 8;
+  RTCScene kept[2 + kEdgeChunks] = {};
+  int chunk_first[kEdgeChunks + 1] = {};  // edge chunk c holds edges [chunk_first[c], chunk_first[c + 1])
+  void release_kept() {
+    for (RTCScene& sc : kept)
+      if (sc) rtcReleaseScene(sc), sc = nullptr;
+  }
   ~Embree() {
+    release_kept();
     if (device) rtcReleaseDevice(device);
   }
   // Box of the paths of vertices ids[0..n).
@@ -177,23 +187,32 @@ struct SelfCollision::Embree {
     o->upper_y = std::nextafter(static_cast<float>(hi[1]), 1e30f);
     o->upper_z = std::nextafter(static_cast<float>(hi[2]), 1e30f);
   }
-  // The edges a scene of edges holds: edges_[first, first + count) (primID 0 is edge `first`).
-  struct EdgeRange {
+  // The primitives a scene holds, of one kind (0 vertices, 1 edges, 2 faces): full ids
+  // first + primID, or ids[primID] if ids is set.
+  struct PrimList {
     const Embree* e;
-    int first;
+    int kind;
+    int first = 0;
+    const int* ids = nullptr;
   };
-  // The edges are collided with each other in kEdgeChunks scenes of consecutive edges, so that
-  // the pairs of chunks (and the vertex-face pairs) are jobs the two threads can share out.
-  static constexpr int kEdgeChunks = 8;
-  EdgeRange ranges[kEdgeChunks + 1] = {};  // all edges, then the chunks
-  // user: what the bounds callback gets as geometryUserPtr (this Embree by default).
-  RTCScene scene(int count, RTCBoundsFunction fn, void* user = nullptr) {
+  // Bounds callback of every scene: the primitive's path box, also stored in prims.
+  static void prim_bounds(const RTCBoundsFunctionArguments* a) {
+    const auto* l = static_cast<const PrimList*>(a->geometryUserPtr);
+    const SelfCollision& sc = *l->e->owner;
+    const int id = l->ids ? l->ids[a->primID] : l->first + static_cast<int>(a->primID);
+    int v[3] = {id, -1, -1}, n = 1;
+    if (l->kind == 1) v[0] = sc.edges_[id][0], v[1] = sc.edges_[id][1], n = 2;
+    if (l->kind == 2) v[0] = sc.F_(id, 0), v[1] = sc.F_(id, 1), v[2] = sc.F_(id, 2), n = 3;
+    l->e->bounds(v, n, a->bounds_o);
+    l->e->prims[l->kind][id] = {*a->bounds_o, {v[0], v[1], v[2]}};
+  }
+  RTCScene scene(int count, const PrimList& list) {
     RTCScene sc = rtcNewScene(device);
     rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_LOW);
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
     rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(count));
-    rtcSetGeometryUserData(geom, user ? user : this);
-    rtcSetGeometryBoundsFunction(geom, fn, nullptr);
+    rtcSetGeometryUserData(geom, const_cast<PrimList*>(&list));
+    rtcSetGeometryBoundsFunction(geom, prim_bounds, nullptr);
     rtcCommitGeometry(geom);
     rtcAttachGeometry(sc, geom);
     rtcReleaseGeometry(geom);
@@ -205,11 +224,17 @@ struct SelfCollision::Embree {
   // once, given to the narrow phase as soon as Embree reports them, so the many pairs it
   // rejects are never stored (storing them and reading them back was a fifth of a detection).
   // Two collides may run at once (each has its own Overlaps).
+  // One side of a collide: which primitives its scene holds, and which pairs to leave out.
+  struct Side {
+    int first = 0;               // full id of the scene's primitive 0 (edge scenes of a range of edges) ...
+    const int* ids = nullptr;    // ... or, if set, the full id of each of its primitives (redetect's scenes)
+    const char* skip = nullptr;  // if set, per full id: pairs with this primitive are left out
+  };
   template <class Out> struct Overlaps {
     const SelfCollision* sc;
-    int first0, first1;     // full id of the scenes' primitive 0 (edge scenes of a range of edges)
+    Side side0, side1;
     bool self;              // both scenes are the same one: keep p < q only
-    const Prim* prim0;      // the scenes' primitives (Embree::prims), indexed like primID0 / primID1
+    const Prim* prim0;      // all primitives of the two kinds (Embree::prims), by full id
     const Prim* prim1;
     const Narrow* narrow;
     SpinLock mutex;  // in case Embree calls back from several threads (a pthread mutex was 4% of a simulation)
@@ -219,13 +244,23 @@ struct SelfCollision::Embree {
   // overlap. Embree also reports some pairs of a BVH leaf whose own boxes do not overlap
   // (which ones depends on the BVH); they are dropped here, so the pairs found do not depend
   // on how the primitives are split into scenes.
-  template <int N0, int N1, class Out> static void gather(void* user, RTCCollision* c, unsigned int n) {
+  // Mapped: a side has ids or skip (redetect's collides).
+  template <int N0, int N1, class Out, bool Mapped> static void gather(void* user, RTCCollision* c, unsigned int n) {
     auto* o = static_cast<Overlaps<Out>*>(user);
     Out keep[64];
     int nk = 0;
     for (unsigned k = 0; k < n; ++k) {
-      const int p = static_cast<int>(c[k].primID0), q = static_cast<int>(c[k].primID1);
+      int p = static_cast<int>(c[k].primID0), q = static_cast<int>(c[k].primID1);
       if (o->self && p >= q) continue;
+      if (Mapped) {
+        p = o->side0.ids ? o->side0.ids[p] : p + o->side0.first;
+        q = o->side1.ids ? o->side1.ids[q] : q + o->side1.first;
+        if ((o->side0.skip && o->side0.skip[p]) || (o->side1.skip && o->side1.skip[q])) continue;
+        if (N0 == 2 && N1 == 2 && p > q) std::swap(p, q);  // an edge-edge pair is (a < b)
+      } else {
+        p += o->side0.first;
+        q += o->side1.first;
+      }
       const Prim& pa = o->prim0[p];
       const Prim& pb = o->prim1[q];
       bool adjacent = false;
@@ -237,7 +272,7 @@ struct SelfCollision::Embree {
       if (ba.lower_x > bb.upper_x || bb.lower_x > ba.upper_x || ba.lower_y > bb.upper_y || bb.lower_y > ba.upper_y ||
           ba.lower_z > bb.upper_z || bb.lower_z > ba.upper_z)
         continue;
-      if (!o->sc->narrow_phase(*o->narrow, p + o->first0, q + o->first1, keep[nk])) continue;
+      if (!o->sc->narrow_phase(*o->narrow, p, q, keep[nk])) continue;
       if (++nk == 64) {
         std::lock_guard<SpinLock> lock(o->mutex);
         o->kept.insert(o->kept.end(), keep, keep + nk);
@@ -249,22 +284,24 @@ struct SelfCollision::Embree {
   }
   // Pairs kept by the last collide of each call site (slot): the next one reserves that
   // many, as growing the list was 2.5% of a simulation.
-  static constexpr int kSlots = 2 + kEdgeChunks * (kEdgeChunks + 1) / 2;  // vertex-face, chunk pairs, tangle
+  // Slots: vertex-face, the pairs of edge chunks, redetect's collides, the tangle test.
+  static constexpr int kRedetectSlot = 1 + kEdgeChunks * (kEdgeChunks + 1) / 2;
+  static constexpr int kSlots = kRedetectSlot + 4 + kEdgeChunks + 1;
   size_t last_count[kSlots] = {};
   // The narrow phase's survivors among the overlaps of scenes a (kind ka) and b (kind kb), in
   // callback order (the caller sorts them). Out: VT (vertices x faces), EE (edges x edges) or
-  // (edge, face) crossings (std::array<int, 2>). first0 / first1: the id of the scenes' primitive 0.
-  template <class Out> std::vector<Out> collide(RTCScene a, int ka, RTCScene b, int kb, int slot, const Narrow& narrow,
-                                                int first0 = 0, int first1 = 0) {
-    if ((ka != 1 && first0 != 0) || (kb != 1 && first1 != 0)) fail("only edge scenes hold a range");
-    Overlaps<Out> o{owner,   first0, first1, a == b, prims[ka].data() + first0, prims[kb].data() + first1,
-                    &narrow, {},     {}};
+  // (edge, face) crossings (std::array<int, 2>).
+  template <class Out>
+  std::vector<Out> collide(RTCScene a, int ka, Side sa, RTCScene b, int kb, Side sb, int slot, const Narrow& narrow) {
+    if ((ka != 1 && sa.first != 0) || (kb != 1 && sb.first != 0)) fail("only edge scenes hold a range");
+    Overlaps<Out> o{owner, sa, sb, a == b, prims[ka].data(), prims[kb].data(), &narrow, {}, {}};
     size_t& last = last_count[slot];
     o.kept.reserve(last + last / 8);
+    const bool mapped = sa.ids || sb.ids || sa.skip || sb.skip;
     RTCCollideFunc fn = nullptr;
-    if (ka == 0 && kb == 2) fn = gather<1, 3, Out>;
-    if (ka == 1 && kb == 1) fn = gather<2, 2, Out>;
-    if (ka == 1 && kb == 2) fn = gather<2, 3, Out>;
+    if (ka == 0 && kb == 2) fn = mapped ? gather<1, 3, Out, true> : gather<1, 3, Out, false>;
+    if (ka == 1 && kb == 1) fn = mapped ? gather<2, 2, Out, true> : gather<2, 2, Out, false>;
+    if (ka == 1 && kb == 2) fn = mapped ? gather<2, 3, Out, true> : gather<2, 3, Out, false>;
     if (!fn) fail("no collide callback for these primitive kinds");
     rtcCollide(a, b, fn, &o);
     const RTCError err = rtcGetDeviceError(device);
@@ -353,53 +390,49 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
   E.prims[1].resize(ne);
   E.prims[2].resize(nf);
   constexpr int K = Embree::kEdgeChunks;
-  int first[K + 1];  // chunk c holds edges [first[c], first[c + 1])
+  int* first = E.chunk_first;
   for (int c = 0; c <= K; ++c) first[c] = static_cast<int>(static_cast<long long>(ne) * c / K);
-  E.ranges[0] = {&E, 0};
-  for (int c = 0; c < K; ++c) E.ranges[c + 1] = {&E, first[c]};
-  auto edge_range_scene = [&](Embree::EdgeRange& r, int count) {
-    return E.scene(
-        count,
-        [](const RTCBoundsFunctionArguments* a) {
-          const auto* r = static_cast<const Embree::EdgeRange*>(a->geometryUserPtr);
-          const int id = r->first + static_cast<int>(a->primID);
-          const auto& ends = r->e->owner->edges_[id];
-          r->e->bounds(ends.data(), 2, a->bounds_o);
-          r->e->prims[1][id] = {*a->bounds_o, {ends[0], ends[1], -1}};
-        },
-        &r);
-  };
-  auto face_scene = [&] {
-    return E.scene(nf, [](const RTCBoundsFunctionArguments* a) {
-      const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
-      const int f = static_cast<int>(a->primID);
-      const int ids[3] = {e->owner->F_(f, 0), e->owner->F_(f, 1), e->owner->F_(f, 2)};
-      e->bounds(ids, 3, a->bounds_o);
-      e->prims[2][f] = {*a->bounds_o, {ids[0], ids[1], ids[2]}};
-    });
-  };
+  // The edges are collided with each other in K scenes of consecutive edges (chunks), so that
+  // the pairs of chunks (and the vertex-face pairs) are jobs the two threads can share out.
+  const Embree::PrimList vertices{&E, 0}, all_edges{&E, 1}, faces{&E, 2};
+  Embree::PrimList chunks[K];
+  for (int c = 0; c < K; ++c) chunks[c] = {&E, 1, first[c]};
   // The narrow phase runs inside the collides' callbacks, each pair on its own, so what is
   // kept does not depend on which thread found it; the kept pairs are sorted afterwards.
   const Narrow narrow{&x, &motion, slack, thickness};
+  if (tangle_test) {
+    // An edge crossing a face now: tight boxes of the current positions (the swept, padded
+    // boxes below would pass several times more candidates for the same exact test). First,
+    // so that the edge and face boxes left in E.prims are the swept ones redetect relies on.
+    E.motion = nullptr;
+    E.pad = 0;
+    ScenesGuard g;
+    g.s[1] = E.scene(ne, all_edges);
+    g.s[2] = E.scene(nf, faces);
+    crossings_ = E.collide<std::array<int, 2>>(g.s[1], 1, {}, g.s[2], 2, {}, Embree::kSlots - 1, narrow);
+    std::sort(crossings_.begin(), crossings_.end());  // the broad phase's order is not fixed
+    intersecting_ = static_cast<int>(crossings_.size());
+    for (const auto& [e, f] : crossings_) {
+      tangled_[edges_[e][0]] = tangled_[edges_[e][1]] = 1;
+      for (int i = 0; i < 3; ++i) tangled_[F_(f, i)] = 1;
+    }
+    E.motion = &motion;
+    E.pad = 0.5 * thickness + slack;
+  }
   {
     // Vertex-face and edge-edge pairs on two threads (Embree's device runs one thread per
     // call), as jobs taken in turn: the vertex-face pairs, then every pair of edge chunks
     // (each unordered pair of edges once, as one scene collided with itself would give them),
     // the largest jobs first. Edge-edge pairs are 2.5x the work of vertex-face ones.
-    ScenesGuard g;  // s[0] vertices, s[1] faces, s[2 + c] edge chunk c
-    static_assert(2 + K <= static_cast<int>(sizeof(g.s) / sizeof(g.s[0])), "one scene per edge chunk");
+    E.release_kept();
+    RTCScene* sc = E.kept;  // [0] vertices, [1] faces, [2 + c] edge chunk c; kept for redetect
     run_jobs(2 + K, [&](int k) {
       if (k == 0)
-        g.s[0] = E.scene(nv, [](const RTCBoundsFunctionArguments* a) {
-          const auto* e = static_cast<const Embree*>(a->geometryUserPtr);
-          const int v = static_cast<int>(a->primID);
-          e->bounds(&v, 1, a->bounds_o);
-          e->prims[0][v] = {*a->bounds_o, {v, -1, -1}};
-        });
+        sc[0] = E.scene(nv, vertices);
       else if (k == 1)
-        g.s[1] = face_scene();
+        sc[1] = E.scene(nf, faces);
       else
-        g.s[k] = edge_range_scene(E.ranges[k - 1], first[k - 1] - first[k - 2]);
+        sc[k] = E.scene(first[k - 1] - first[k - 2], chunks[k - 2]);
     });
     std::vector<std::array<int, 2>> jobs = {{-1, -1}};             // (-1, -1): vertex-face; (c, d): edge chunks c <= d
     auto empty = [&](int c) { return first[c + 1] == first[c]; };  // (Embree's collide crashed on an empty scene)
@@ -413,16 +446,81 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     run_jobs(njobs, [&](int k) {
       const auto [c, d] = jobs[k];
       if (c < 0)
-        vt_ = E.collide<VT>(g.s[0], 0, g.s[1], 2, 0, narrow);
+        vt_ = E.collide<VT>(sc[0], 0, {}, sc[1], 2, {}, 0, narrow);
       else
-        ee_parts[k] = E.collide<EE>(g.s[2 + c], 1, g.s[2 + d], 1, k, narrow, first[c], first[d]);
+        ee_parts[k] = E.collide<EE>(sc[2 + c], 1, {first[c]}, sc[2 + d], 1, {first[d]}, k, narrow);
     });
     size_t total = 0;
     for (const auto& part : ee_parts) total += part.size();
     ee_.reserve(total);
     for (const auto& part : ee_parts) ee_.insert(ee_.end(), part.begin(), part.end());
   }
-  // Kept pairs in a fixed order (the broad phase's order is not).
+  sort_pairs();
+}
+
+void SelfCollision::redetect(const Points3& x, const Points3& start, const Points3& motion,
+                             const std::vector<char>& moved, double slack, double thickness) {
+  const int nf = static_cast<int>(F_.rows()), nv = static_cast<int>(x.rows()), ne = static_cast<int>(edges_.size());
+  if (start.rows() != nv || motion.rows() != nv || static_cast<int>(moved.size()) != nv ||
+      static_cast<int>(tangled_.size()) != nv)
+    fail("positions, paths or moved flags do not match the vertex count");
+  if (!(slack >= 0) || !(thickness > 0)) fail("slack must be >= 0 and thickness > 0");
+  if (nf < 2) return;
+  auto& E = *embree_;
+  if (!E.kept[0]) fail("redetect needs a detect first");
+  // The moved primitives: ids[0] vertices, ids[1] edges, ids[2] faces with a moved vertex.
+  std::vector<int> ids[3];
+  std::vector<char> moved_e(ne, 0), moved_f(nf, 0);
+  for (int v = 0; v < nv; ++v)
+    if (moved[v]) ids[0].push_back(v);
+  if (ids[0].empty()) return;
+  for (int e = 0; e < ne; ++e)
+    if (moved[edges_[e][0]] || moved[edges_[e][1]]) ids[1].push_back(e), moved_e[e] = 1;
+  for (int f = 0; f < nf; ++f)
+    if (moved[F_(f, 0)] || moved[F_(f, 1)] || moved[F_(f, 2)]) ids[2].push_back(f), moved_f[f] = 1;
+  ++redetections_;
+  vt_.erase(std::remove_if(vt_.begin(), vt_.end(), [&](const VT& c) { return moved[c.v] || moved_f[c.f]; }), vt_.end());
+  ee_.erase(std::remove_if(ee_.begin(), ee_.end(), [&](const EE& c) { return moved_e[c.a] || moved_e[c.b]; }),
+            ee_.end());
+
+  E.x = &start;
+  E.motion = &motion;
+  E.pad = 0.5 * thickness + slack;
+  E.owner = this;
+  const Embree::PrimList lists[3] = {{&E, 0, 0, ids[0].data()}, {&E, 1, 0, ids[1].data()}, {&E, 2, 0, ids[2].data()}};
+  ScenesGuard g;  // s[k]: the moved primitives of kind k
+  run_jobs(3, [&](int k) {
+    if (!ids[k].empty()) g.s[k] = E.scene(static_cast<int>(ids[k].size()), lists[k]);
+  });
+  // Each pair with a moved primitive once: moved x unmoved (the unmoved side in detect's
+  // scenes, its moved primitives skipped there), moved x moved.
+  constexpr int K = Embree::kEdgeChunks;
+  const Narrow narrow{&start, &motion, slack, thickness, &x};
+  using Side = Embree::Side;
+  const Side mv{0, ids[0].data()}, me{0, ids[1].data()}, mf{0, ids[2].data()};
+  std::vector<VT> vt_parts[3];
+  std::vector<EE> ee_parts[1 + K];
+  run_jobs(4 + K, [&](int k) {
+    const int slot = Embree::kRedetectSlot + k;
+    if (k == 0)
+      vt_parts[0] = E.collide<VT>(g.s[0], 0, mv, E.kept[1], 2, {0, nullptr, moved_f.data()}, slot, narrow);
+    else if (k == 1 && g.s[2])
+      vt_parts[1] = E.collide<VT>(E.kept[0], 0, {0, nullptr, moved.data()}, g.s[2], 2, mf, slot, narrow);
+    else if (k == 2 && g.s[2])
+      vt_parts[2] = E.collide<VT>(g.s[0], 0, mv, g.s[2], 2, mf, slot, narrow);
+    else if (k == 3 && g.s[1])
+      ee_parts[0] = E.collide<EE>(g.s[1], 1, me, g.s[1], 1, me, slot, narrow);
+    else if (k >= 4 && g.s[1] && E.chunk_first[k - 3] > E.chunk_first[k - 4])  // (collide crashed on an empty scene)
+      ee_parts[k - 3] = E.collide<EE>(g.s[1], 1, me, E.kept[2 + k - 4], 1,
+                                      {E.chunk_first[k - 4], nullptr, moved_e.data()}, slot, narrow);
+  });
+  for (const auto& part : vt_parts) vt_.insert(vt_.end(), part.begin(), part.end());
+  for (const auto& part : ee_parts) ee_.insert(ee_.end(), part.begin(), part.end());
+  sort_pairs();
+}
+
+void SelfCollision::sort_pairs() {
+  const int nv = static_cast<int>(tangled_.size()), ne = static_cast<int>(edges_.size());
 #pragma omp parallel sections num_threads(2)
   {
 #pragma omp section
@@ -432,22 +530,18 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     sort_unique_pairs(
         ee_, ne, [](const EE& c) { return c.a; }, [](const EE& c) { return c.b; });
   }
-  if (tangle_test) {
-    // An edge crossing a face now: tight boxes of the current positions (the swept, padded
-    // boxes above would pass several times more candidates for the same exact test).
-    E.motion = nullptr;
-    E.pad = 0;
-    ScenesGuard g;
-    g.s[1] = edge_range_scene(E.ranges[0], ne);
-    g.s[2] = face_scene();
-    crossings_ = E.collide<std::array<int, 2>>(g.s[1], 1, g.s[2], 2, Embree::kSlots - 1, narrow);
-    std::sort(crossings_.begin(), crossings_.end());  // the broad phase's order is not fixed
-    intersecting_ = static_cast<int>(crossings_.size());
-    for (const auto& [e, f] : crossings_) {
-      tangled_[edges_[e][0]] = tangled_[edges_[e][1]] = 1;
-      for (int i = 0; i < 3; ++i) tangled_[F_(f, i)] = 1;
-    }
-  }
+}
+
+std::vector<std::array<int, 2>> SelfCollision::vertex_triangle_pairs() const {
+  std::vector<std::array<int, 2>> out;
+  for (const VT& c : vt_) out.push_back({c.v, c.f});
+  return out;
+}
+
+std::vector<std::array<int, 2>> SelfCollision::edge_edge_pairs() const {
+  std::vector<std::array<int, 2>> out;
+  for (const EE& c : ee_) out.push_back({c.a, c.b});
+  return out;
 }
 
 bool SelfCollision::narrow_phase(const Narrow& n, int v, int g, VT& out) const {
@@ -463,7 +557,13 @@ bool SelfCollision::narrow_phase(const Narrow& n, int v, int g, VT& out) const {
   if (d >= reach) return false;
   Vec3 bary, nrm;
   double dist = 0;
-  if (!project_on_triangle(p, a, b, c, bary, nrm, dist)) return false;
+  if (n.side) {  // the side from other positions (redetect's)
+    const Points3& y = *n.side;
+    if (!project_on_triangle(y.row(v), y.row(F_(g, 0)), y.row(F_(g, 1)), y.row(F_(g, 2)), bary, nrm, dist))
+      return false;
+  } else if (!project_on_triangle(p, a, b, c, bary, nrm, dist)) {
+    return false;
+  }
   out = {v, g, static_cast<signed char>(dist >= 0 ? 1 : -1), static_cast<float>(reach)};
   return true;
 }
@@ -480,9 +580,16 @@ bool SelfCollision::narrow_phase(const Narrow& n, int ea, int eb, EE& out) const
     return false;
   double s = 0, t = 0;
   closest_segments(p1, q1, p2, q2, s, t);
-  const Vec3 d = (p1 + s * (q1 - p1)) - (p2 + t * (q2 - p2));
-  const double len = d.norm();
+  Vec3 d = (p1 + s * (q1 - p1)) - (p2 + t * (q2 - p2));
+  double len = d.norm();
   if (len >= reach) return false;
+  if (n.side) {  // the side from other positions (redetect's)
+    const Points3& y = *n.side;
+    const Vec3 r1 = y.row(i0), t1 = y.row(i1), r2 = y.row(j0), t2 = y.row(j1);
+    closest_segments(r1, t1, r2, t2, s, t);
+    d = (r1 + s * (t1 - r1)) - (r2 + t * (t2 - r2));
+    len = d.norm();
+  }
   out.a = ea;
   out.b = eb;
   out.set_dir(len > 0 ? Vec3(d / len) : Vec3::Zero());

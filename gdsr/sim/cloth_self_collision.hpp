@@ -5,7 +5,8 @@
 // faces for the tangle test) on boxes swept along each vertex's
 // predicted motion until the next detection and grown by a slack, so every pair that can
 // meet before the next detection is found (no tunnelling while each vertex stays within the
-// slack of its predicted path; the solver re-detects as soon as one leaves it). Narrow
+// slack of its predicted path; as soon as one leaves it, the solver gives it a new path and
+// finds its pairs again, redetect, against the boxes the detection built for the rest). Narrow
 // phase: exact point-triangle and segment-segment distances against the pair's relative
 // motion, so cloth that moves along together does not pay for its speed. Only pairs whose two
 // boxes overlap are kept (Embree's collide also reports some pairs of a BVH leaf whose own boxes
@@ -61,6 +62,18 @@ class SelfCollision {
   void detect(const gdsr::Points3& x, const gdsr::Points3& motion, double slack, double thickness,
               bool tangle_test = true);
 
+  // After detect, when some vertices left their slack: moved[v] != 0 marks the vertices whose
+  // path changed since that detect. Every vertex v is now on the path start.row(v) + a
+  // motion.row(v), a in [0, 1], until the end of the detect's interval (for an unmoved vertex,
+  // the rest of the path it was detected on). The pairs of every vertex, edge and face with a
+  // moved vertex are found again by detect's rule on these paths, their sides taken from x (the
+  // current positions, intersection-free); the other pairs are kept as they were. Only the moved
+  // primitives' boxes are rebuilt, and collided with the scenes detect built (their boxes still
+  // bound the unmoved primitives' paths), so this costs a fraction of a detect when few moved.
+  // Tangled vertices are not refreshed.
+  void redetect(const gdsr::Points3& x, const gdsr::Points3& start, const gdsr::Points3& motion,
+                const std::vector<char>& moved, double slack, double thickness);
+
   // One Gauss-Seidel pass over the pairs (fixed order): pushes pairs closer than
   // `thickness` apart along the triangle normal / edge-edge normal, by inverse masses winv
   // (0 = fixed), by at most `max_crossed_push` metres: set it to `thickness` or more, and it
@@ -82,7 +95,12 @@ class SelfCollision {
   const std::vector<char>& tangled() const { return tangled_; }  // per vertex, 1: tangled (as above)
   // Edge-triangle pairs (no shared vertex) found crossing at the last tangle test.
   int num_intersecting_pairs() const { return intersecting_; }
-  long long num_detections() const { return detections_; }  // since construction
+  long long num_detections() const { return detections_; }      // since construction
+  long long num_redetections() const { return redetections_; }  // since construction
+  // The pairs kept: (vertex, face) and (edge a, edge b), edges numbered as in edges().
+  std::vector<std::array<int, 2>> vertex_triangle_pairs() const;
+  std::vector<std::array<int, 2>> edge_edge_pairs() const;
+  const std::vector<std::array<int, 2>>& edges() const { return edges_; }  // unique edges (i < j)
 
  private:
   // reach: metres the pair may be found on the wrong side of its remembered side before it is
@@ -109,12 +127,15 @@ class SelfCollision {
     const gdsr::Points3* x;
     const gdsr::Points3* motion;
     double slack, thickness;
+    const gdsr::Points3* side = nullptr;  // positions the pairs' sides are taken from (null: x)
   };
   // Narrow phase of one pair: true (and `out` filled) if it is kept. Vertex v and face f
   // within reach (VT), edges a < b within reach (EE), edge e crossing face f (tangle test).
   bool narrow_phase(const Narrow& n, int v, int f, VT& out) const;
   bool narrow_phase(const Narrow& n, int a, int b, EE& out) const;
   bool narrow_phase(const Narrow& n, int e, int f, std::array<int, 2>& out) const;
+  // The kept pairs in a fixed order (the broad phase's is not), repeats dropped.
+  void sort_pairs();
   gdsr::Faces F_;
   std::vector<std::array<int, 2>> edges_;  // unique edges (i < j)
   std::vector<std::array<int, 2>> edge_faces_;  // the (one or two) faces of each edge, -1: none
@@ -125,6 +146,7 @@ class SelfCollision {
   std::vector<char> tangled_;
   int intersecting_ = 0;
   long long detections_ = 0;
+  long long redetections_ = 0;
   struct Embree;
   std::unique_ptr<Embree> embree_;
 };

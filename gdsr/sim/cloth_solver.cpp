@@ -425,7 +425,8 @@ void ClothSolver::detect_self_contacts(double h) {
   // the motion over it is within twice the boxes' padding (at the padding itself, a skirt on
   // 01_01 detected so often that it ran 9% slower). Any interval is safe: every vertex is still
   // tracked against its slack.
-  if (!self_ || since_detect_ < detect_interval_) return;
+  if (!self_) return;
+  if (since_detect_ < detect_interval_ && (left_slack_.empty() || redetect_self_contacts(h))) return;
   const int nv = static_cast<int>(x_.rows());
   std::vector<double> speed(nv);
   // The guide's pull (track_guide) moves the cloth too: left out of the motion, a pair it pushed
@@ -446,6 +447,35 @@ void ClothSolver::detect_self_contacts(double h) {
   tangle_test_due_ = false;
   x_detect_ = x_;
   since_detect_ = 0;
+  left_slack_.clear();
+  redetected_.assign(nv, 0);
+}
+
+bool ClothSolver::redetect_self_contacts(double h) {
+  // Vertices left their slack mid-interval (a limb pushed them, say: on salsa 61_03 that was half
+  // of all detections, most after one substep, a few vertices at a time): only they get a new
+  // path, from where they are over the rest of the interval, and only their pairs are found
+  // again (SelfCollision::redetect); the pairs of the rest are still good. A full detection
+  // instead when it also owes the frame's tangle test, or when many vertices have moved.
+  const int nv = static_cast<int>(x_.rows());
+  int moved = static_cast<int>(std::count(redetected_.begin(), redetected_.end(), 1));
+  for (int v : left_slack_) moved += !redetected_[v];
+  if (!p_.self_redetect || tangle_test_due_ || moved > nv / 4) return false;
+  const double a = static_cast<double>(since_detect_) / detect_interval_;  // of the interval, gone
+  const int left = detect_interval_ - since_detect_;                       // substeps to go
+  const double T = left * h;
+  const bool pulled = pull_step_.rows() == nv;
+  for (int v : left_slack_) {
+    Vec3 m = v_.row(v).transpose() * T + (winv_[v] == 0 ? 0.0 : 0.5 * T * T) * p_.gravity;
+    if (pulled) m += left * pull_step_.row(v).transpose();
+    motion_.row(v) = m.transpose() / (1 - a);
+    x_detect_.row(v) = x_.row(v) - a * motion_.row(v);
+    redetected_[v] = 1;
+  }
+  left_slack_.clear();
+  const Points3 start = x_detect_ + a * motion_, rest = (1 - a) * motion_;
+  self_->redetect(x_, start, rest, redetected_, p_.self_slack, p_.self_thickness);
+  return true;
 }
 
 void ClothSolver::predict(double h, double decay) {
@@ -598,14 +628,17 @@ void ClothSolver::update_velocities(double h) {
 }
 
 void ClothSolver::track_self_slack() {
-  // Re-detect early when a vertex left the slack around its predicted path.
+  // The vertices that left the slack around their predicted path: their pairs are found again
+  // at the next substep (redetect_self_contacts).
   if (!self_) return;
   ++since_detect_;
   const int nv = static_cast<int>(x_.rows());
   const double a = static_cast<double>(since_detect_) / detect_interval_;
   const double s2 = p_.self_slack * p_.self_slack;
-  for (int v = 0; v < nv && since_detect_ < detect_interval_; ++v)
-    if ((x_.row(v) - x_detect_.row(v) - a * motion_.row(v)).squaredNorm() > s2) since_detect_ = detect_interval_;
+  left_slack_.clear();
+  if (since_detect_ >= detect_interval_) return;  // detected anew next substep anyway
+  for (int v = 0; v < nv; ++v)
+    if ((x_.row(v) - x_detect_.row(v) - a * motion_.row(v)).squaredNorm() > s2) left_slack_.push_back(v);
 }
 
 void ClothSolver::set_guide(const GuideTracker* tracker, const Points3* from, const Points3* to) {

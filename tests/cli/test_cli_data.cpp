@@ -231,7 +231,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
                         " --iterations 3 --friction 0.1 --self-thickness 0.002 --no-self-collision"
                         " --compression-ratio 0.5 --compression-exponent 1.5 --settle-frames 3 --contact-every 2"
                         " --self-slack 0.002 --self-detect-every 3 --self-slack-per-pd 0.25 --self-passes 2"
-                        " --no-limbs-pass-through --no-limbs-pass-until-clear --untangle-step 0.25"
+                        " --no-limbs-pass-through --no-limbs-pass-until-clear --untangle-step 0.25 --no-self-redetect"
                         " --track-rate 4 --max-push-step 0.01 --pinch-separation 0.08");
   REQUIRE(mk.status == 0);
   const std::string manifest = gdsr_test::slurp(out + "/manifest.json");
@@ -249,6 +249,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"self_slack_per_pd\": 0.25") != std::string::npos);
   CHECK(manifest.find("\"limbs_pass_through\": false") != std::string::npos);
   CHECK(manifest.find("\"limbs_pass_until_clear\": false") != std::string::npos);
+  CHECK(manifest.find("\"self_redetect\": false") != std::string::npos);
   CHECK(manifest.find("\"untangle_step\": 0.25") != std::string::npos);
   CHECK(manifest.find("\"hr_track_rate_1_s\": 4") != std::string::npos);
   CHECK(manifest.find("\"max_push_step_m\": 0.01") != std::string::npos);

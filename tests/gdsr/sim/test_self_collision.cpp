@@ -139,6 +139,24 @@ double segment_distance(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Ve
   return to_second(0.5 * (lo + hi));
 }
 
+// Two crumpled 20 cm sheets 4 mm apart at 10 mm (random offsets up to 3 mm per axis), with
+// random motions (up to 2 mm per axis).
+struct CrumpledSheets {
+  gdsr::GarmentMesh m;
+  Points3 x, motion;
+  explicit CrumpledSheets(unsigned seed) : m(merge(sheet(0.2, 0.01, 0.0), sheet(0.2, 0.01, 0.004))) {
+    const int nv = static_cast<int>(m.V.rows());
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    x = m.V;
+    motion.resize(nv, 3);
+    for (int v = 0; v < nv; ++v) {
+      x.row(v) += 0.003 * Eigen::RowVector3d(u(rng), u(rng), u(rng));
+      motion.row(v) = 0.002 * Eigen::RowVector3d(u(rng), u(rng), u(rng));
+    }
+  }
+};
+
 }  // namespace
 
 TEST_CASE("self-collision: detect keeps every pair within reach that a search over all pairs finds") {
@@ -148,16 +166,10 @@ TEST_CASE("self-collision: detect keeps every pair within reach that a search ov
   // thickness + relative motion + 2 slack (the header's rule); without motion these are all
   // pairs closer than thickness + 2 slack. The edge-edge pairs come from every pair of several
   // scenes (chunks) of consecutive edges, so this also holds the chunks to one scene of all edges.
-  auto a = sheet(0.2, 0.01, 0.0), b = sheet(0.2, 0.01, 0.004);
-  const auto m = merge(a, b);
+  const CrumpledSheets sheets(5);
+  const auto& m = sheets.m;
+  const Points3 &x = sheets.x, &moving = sheets.motion;
   const int nv = static_cast<int>(m.V.rows());
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-1, 1);
-  Points3 x = m.V, moving(nv, 3);
-  for (int v = 0; v < nv; ++v) {
-    x.row(v) += 0.003 * Eigen::RowVector3d(u(rng), u(rng), u(rng));
-    moving.row(v) = 0.002 * Eigen::RowVector3d(u(rng), u(rng), u(rng));
-  }
   const double thickness = 0.005, slack = 0.001, pad = 0.5 * thickness + slack;
   std::vector<std::array<int, 2>> edges;
   for (int f = 0; f < m.F.rows(); ++f)
@@ -224,6 +236,114 @@ TEST_CASE("self-collision: detect keeps every pair within reach that a search ov
     CHECK(sc.num_vertex_triangle() <= vt_maybe);
     CHECK(sc.num_edge_edge() >= ee_sure);
     CHECK(sc.num_edge_edge() <= ee_maybe);
+  }
+}
+
+TEST_CASE("self-collision: redetect finds the moved vertices' pairs again and keeps the others") {
+  // The two crumpled sheets of the test above, moving; halfway through the interval 5% of the
+  // vertices leave their paths (moved up to 4 mm, new motions). redetect must keep every pair
+  // without a moved primitive as detect found it, and find every pair with one that detect
+  // finds on the new paths (the header's rule), plus only pairs within reach (the boxes it keeps
+  // of unmoved primitives cover the whole interval, not only the rest of it).
+  const CrumpledSheets sheets(7);
+  const auto& m = sheets.m;
+  const Points3 &x = sheets.x, &motion = sheets.motion;
+  const int nv = static_cast<int>(m.V.rows());
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double thickness = 0.005, slack = 0.001, half = 0.5;
+  sim::SelfCollision sc(m.F, nv);
+  sc.detect(x, motion, slack, thickness, /*tangle_test=*/false);
+  const auto vt0 = sc.vertex_triangle_pairs();
+  const auto ee0 = sc.edge_edge_pairs();
+
+  Points3 start = x + half * motion, rest = (1 - half) * motion;
+  std::vector<char> moved(nv, 0);
+  sc.redetect(start, start, rest, moved, slack, thickness);  // none moved: nothing to do
+  CHECK(sc.num_redetections() == 0);
+  CHECK(sc.vertex_triangle_pairs() == vt0);
+  CHECK(sc.edge_edge_pairs() == ee0);
+
+  for (int v = 0; v < nv; ++v)
+    if (u(rng) > 0.9) {
+      moved[v] = 1;
+      start.row(v) += 0.004 * Eigen::RowVector3d(u(rng), u(rng), u(rng));
+      rest.row(v) = 0.002 * Eigen::RowVector3d(u(rng), u(rng), u(rng));
+    }
+  sc.redetect(start, start, rest, moved, slack, thickness);
+  CHECK(sc.num_redetections() == 1);
+  CHECK(sc.num_detections() == 1);
+  sim::SelfCollision ref(m.F, nv);
+  ref.detect(start, rest, slack, thickness, /*tangle_test=*/false);
+
+  const auto& edges = sc.edges();
+  auto face_moved = [&](int f) { return moved[m.F(f, 0)] || moved[m.F(f, 1)] || moved[m.F(f, 2)]; };
+  auto edge_moved = [&](int e) { return moved[edges[e][0]] || moved[edges[e][1]]; };
+  auto vt_moved = [&](const std::array<int, 2>& c) { return moved[c[0]] || face_moved(c[1]); };
+  auto ee_moved = [&](const std::array<int, 2>& c) { return edge_moved(c[0]) || edge_moved(c[1]); };
+  auto rel = [&](std::initializer_list<int> s, std::initializer_list<int> t) {
+    double r = 0;
+    for (int p : s)
+      for (int q : t) r = std::max(r, (rest.row(p) - rest.row(q)).norm());
+    return r;
+  };
+  // Pairs of one kind: the unmoved ones as detect found them; the moved ones a superset of the
+  // reference's, each extra one within reach.
+  auto check_kind = [&](const std::vector<std::array<int, 2>>& got, const std::vector<std::array<int, 2>>& before,
+                        const std::vector<std::array<int, 2>>& want, auto is_moved, auto within_reach) {
+    std::vector<std::array<int, 2>> got_kept, got_new, before_kept, want_new;
+    for (const auto& c : got) (is_moved(c) ? got_new : got_kept).push_back(c);
+    for (const auto& c : before)
+      if (!is_moved(c)) before_kept.push_back(c);
+    for (const auto& c : want)
+      if (is_moved(c)) want_new.push_back(c);
+    CHECK(std::is_sorted(got.begin(), got.end()));
+    CHECK(got_kept == before_kept);
+    CHECK(want_new.size() > 300);  // a fair share of the pairs is refreshed
+    CHECK(std::includes(got_new.begin(), got_new.end(), want_new.begin(), want_new.end()));
+    int extra = 0, beyond = 0;
+    for (const auto& c : got_new)
+      if (!std::binary_search(want_new.begin(), want_new.end(), c)) ++extra, beyond += !within_reach(c);
+    MESSAGE(got_new.size() << " pairs refreshed, " << want_new.size() << " by detect on the new paths; " << extra
+                           << " more, " << beyond << " of them beyond reach");
+    CHECK(beyond == 0);
+  };
+  check_kind(sc.vertex_triangle_pairs(), vt0, ref.vertex_triangle_pairs(), vt_moved, [&](const std::array<int, 2>& c) {
+    const int v = c[0], i = m.F(c[1], 0), j = m.F(c[1], 1), k = m.F(c[1], 2);
+    const Vec3 p = start.row(v);
+    const double d = (p - gdsr::closest_point_on_triangle(p, start.row(i), start.row(j), start.row(k)).point).norm();
+    return d < (thickness + rel({v}, {i, j, k}) + 2 * slack) * (1 + 1e-9);
+  });
+  check_kind(sc.edge_edge_pairs(), ee0, ref.edge_edge_pairs(), ee_moved, [&](const std::array<int, 2>& c) {
+    const auto &e1 = edges[c[0]], &e2 = edges[c[1]];
+    const double d = segment_distance(start.row(e1[0]), start.row(e1[1]), start.row(e2[0]), start.row(e2[1]));
+    return d < (thickness + rel({e1[0], e1[1]}, {e2[0], e2[1]}) + 2 * slack) * (1 + 1e-9);
+  });
+}
+
+TEST_CASE("self-collision: redetecting the vertices that left their slack gives the full detection's simulation") {
+  // The sheet dropped onto a clamped sheet (below), with SimParams::self_redetect on and off:
+  // the same positions to the bit, in fewer full detections.
+  std::vector<Points3> out[2];
+  long long full[2] = {}, partial[2] = {};
+  for (int k = 0; k < 2; ++k) {
+    TwoSheetDrop d(0.03);
+    d.p.self_redetect = k == 0;
+    d.solver = std::make_unique<sim::ClothSolver>(d.g, gdsr::Faces(), Points3(), d.p);
+    for (int t = 0; t < 20; ++t) {
+      d.solver->step(Points3(), Points3(), 1.0 / 30);
+      out[k].push_back(d.solver->positions());
+    }
+    full[k] = d.solver->num_self_detections();
+    partial[k] = d.solver->num_self_redetections();
+  }
+  MESSAGE("detections " << full[0] << " + " << partial[0] << " redetections, against " << full[1]);
+  CHECK(partial[0] > 20);
+  CHECK(partial[1] == 0);
+  CHECK(full[0] < full[1]);
+  for (int t = 0; t < 20; ++t) {
+    CAPTURE(t);
+    CHECK(out[0][t] == out[1][t]);
   }
 }
 
