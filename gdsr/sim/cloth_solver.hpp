@@ -287,9 +287,10 @@ struct SimParams {
                                            // pants 63% at 3 mm, 100% at 5 mm)
   int self_detect_every = 4;      // substeps between self-contact detections (sooner when a vertex leaves its slack)
   bool self_redetect = true;      // a vertex that left its slack: only its pairs are found again (SelfCollision::
-                                  // redetect); false: all pairs, as before revision 22. Same pairs where it matters
-                                  // (the datasets of revision 21 byte for byte on salsa 61_03), LR 0.13 -> 0.08 s a
-                                  // frame (pants), HR 0.90 -> 0.80 (pleated skirt)
+                                  // redetect); false: all pairs, as before revision 22. On 1 s of salsa 61_03 the
+                                  // datasets of revision 21 byte for byte, LR 0.13 -> 0.08 s a frame (pants), HR
+                                  // 0.90 -> 0.80 (pleated skirt); over 4 s the pants and t-shirt drift apart (the
+                                  // t-shirt's clip is chaotic: a 1e-5 friction nudge moves it as much)
   double self_slack = 0.003;      // m, how far a vertex may leave its predicted path before re-detection
   double self_slack_per_pd = 0.15;  // ... and at most this fraction of the particle distance, self_detect_every then
                                     // growing as the slack shrinks (8 substeps at 10 mm). Every pair within slack
