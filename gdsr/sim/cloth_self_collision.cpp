@@ -188,7 +188,8 @@ struct SelfCollision::Embree {
     o->upper_z = std::nextafter(static_cast<float>(hi[2]), 1e30f);
   }
   // The primitives a scene holds, of one kind (0 vertices, 1 edges, 2 faces): full ids
-  // first + primID, or ids[primID] if ids is set.
+  // first + primID, or ids[primID] if ids is set. Read only while the scene is committed (by
+  // prim_bounds), so a kept scene may outlive the list it was built from.
   struct PrimList {
     const Embree* e;
     int kind;
