@@ -438,17 +438,22 @@ void ClothSolver::detect_self_contacts(double h) {
   const double pad = 0.5 * p_.self_thickness + p_.self_slack;
   detect_interval_ = p_.self_detect_every;
   while (detect_interval_ > 1 && speed[q] * detect_interval_ * h > 2 * pad) detect_interval_ = (detect_interval_ + 1) / 2;
-  const double T = detect_interval_ * h;
-  for (int v = 0; v < nv; ++v) {
-    motion_.row(v) = v_.row(v) * T + (winv_[v] == 0 ? 0.0 : 0.5 * T * T) * p_.gravity.transpose();
-    if (pulled) motion_.row(v) += detect_interval_ * pull_step_.row(v);
-  }
+  for (int v = 0; v < nv; ++v) motion_.row(v) = predicted_motion(v, detect_interval_, h);
   self_->detect(x_, motion_, p_.self_slack, p_.self_thickness, tangle_test_due_);
   tangle_test_due_ = false;
   x_detect_ = x_;
   since_detect_ = 0;
   left_slack_.clear();
   redetected_.assign(nv, 0);
+}
+
+Eigen::RowVector3d ClothSolver::predicted_motion(int v, int substeps, double h) const {
+  // Free flight (a pinned vertex keeps its velocity) plus the guide's pull (track_guide; see
+  // detect_self_contacts for why it counts).
+  const double T = substeps * h;
+  Eigen::RowVector3d m = v_.row(v) * T + (winv_[v] == 0 ? 0.0 : 0.5 * T * T) * p_.gravity.transpose();
+  if (pull_step_.rows() == x_.rows()) m += substeps * pull_step_.row(v);
+  return m;
 }
 
 bool ClothSolver::redetect_self_contacts(double h) {
@@ -463,12 +468,8 @@ bool ClothSolver::redetect_self_contacts(double h) {
   if (!p_.self_redetect || tangle_test_due_ || moved > nv / 4) return false;
   const double a = static_cast<double>(since_detect_) / detect_interval_;  // of the interval, gone
   const int left = detect_interval_ - since_detect_;                       // substeps to go
-  const double T = left * h;
-  const bool pulled = pull_step_.rows() == nv;
   for (int v : left_slack_) {
-    Vec3 m = v_.row(v).transpose() * T + (winv_[v] == 0 ? 0.0 : 0.5 * T * T) * p_.gravity;
-    if (pulled) m += left * pull_step_.row(v).transpose();
-    motion_.row(v) = m.transpose() / (1 - a);
+    motion_.row(v) = predicted_motion(v, left, h) / (1 - a);
     x_detect_.row(v) = x_.row(v) - a * motion_.row(v);
     redetected_[v] = 1;
   }

@@ -417,6 +417,7 @@ class ClothSolver {
   // The steps of one substep of length h (seconds), in the order step() runs them.
   void detect_self_contacts(double h);
   bool redetect_self_contacts(double h);
+  Eigen::RowVector3d predicted_motion(int v, int substeps, double h) const;  // m, of vertex v over the next substeps
   void predict(double h, double decay);
   void classify_edges();
   void solve_edges(std::vector<double>& lambda, double h2);
