@@ -273,6 +273,42 @@ ClosestPoints BodyQuery::closest(const Points3& Q, bool smooth_normals, double m
   return r;
 }
 
+namespace {
+struct WithinData {
+  const TriMesh* mesh;
+  const std::function<bool(int)>* accept;
+  Vec3 q;
+  double r2;
+  bool found;
+};
+
+bool within_callback(RTCPointQueryFunctionArguments* args) {
+  auto* d = static_cast<WithinData*>(args->userPtr);
+  const int f = static_cast<int>(args->primID);
+  if (d->found || !(*d->accept)(f)) return false;
+  const TriMesh& M = *d->mesh;
+  const Vec3 a = M.V.row(M.F(f, 0)), b = M.V.row(M.F(f, 1)), c = M.V.row(M.F(f, 2));
+  if ((closest_point_on_triangle(d->q, a, b, c).point - d->q).squaredNorm() > d->r2) return false;
+  d->found = true;
+  args->query->radius = 0.f;  // nothing more to look for
+  return true;
+}
+}  // namespace
+
+bool BodyQuery::any_face_within(const Vec3& q, double radius, const std::function<bool(int)>& accept) const {
+  if (!q.allFinite()) gdsr::fail("BodyQuery::any_face_within", "query point is not finite");
+  if (!(radius >= 0)) gdsr::fail("BodyQuery::any_face_within", "radius must be >= 0");
+  WithinData d{&impl_->mesh, &accept, q, radius * radius, false};
+  RTCPointQuery pq;
+  pq.x = static_cast<float>(q.x()), pq.y = static_cast<float>(q.y()), pq.z = static_cast<float>(q.z());
+  pq.radius = static_cast<float>(radius * (1 + 1e-5) + 1e-6);  // conservative: Embree's bounds are float
+  pq.time = 0.f;
+  RTCPointQueryContext ctx;
+  rtcInitPointQueryContext(&ctx);
+  rtcPointQuery(impl_->scene, &pq, &ctx, within_callback, &d);
+  return d.found;
+}
+
 RayHits BodyQuery::intersect(const Points3& O, const Points3& D, double tmin, double tmax) const {
   const Impl& m = *impl_;
   const Eigen::Index n = O.rows();

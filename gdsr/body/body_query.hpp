@@ -15,6 +15,7 @@
 
 #include "gdsr/geometry/mesh.hpp"
 
+#include <functional>
 #include <limits>
 #include <memory>
 
@@ -54,6 +55,10 @@ class BodyQuery {
   ClosestPoints closest(const Points3& Q, bool smooth_normals = true,
                         double max_distance = std::numeric_limits<double>::infinity()) const;
 
+  // Whether a triangle f with accept(f) has a point within `radius` metres of q (exact in double
+  // precision; Embree's float BVH only culls). accept may be called for some triangles farther
+  // away, and not at all once one is found.
+  bool any_face_within(const Vec3& q, double radius, const std::function<bool(int face)>& accept) const;
   // Ray casts: origins and directions N x 3 (directions need not be unit; t is in units of
   // the direction's length), hits with t in [tmin, tmax]. Throws on non-finite input or
   // zero directions.

@@ -75,9 +75,8 @@ struct Depths {
 // frame, where body parts are told apart.
 Depths penetration(const BodyQuery& body, const ClosestPoints& cp, const Points3& body_rest, const Points3& X,
                    const ValidityOptions& opt) {
-  const Points3& B = body.mesh().V;
   const Faces& F = body.mesh().F;
-  const double reach2 = opt.pinch_reach * opt.pinch_reach, sep2 = opt.pinch_separation * opt.pinch_separation;
+  const double sep2 = opt.pinch_separation * opt.pinch_separation;
   Depths d;
   for (long i = 0; i < X.rows(); ++i) {
     if (cp.face(i) < 0 || !(cp.sdist(i) < 0)) continue;
@@ -86,11 +85,12 @@ Depths penetration(const BodyQuery& body, const ClosestPoints& cp, const Points3
     const int f = cp.face(i);
     const Vec3 rest = cp.bary(i, 0) * body_rest.row(F(f, 0)) + cp.bary(i, 1) * body_rest.row(F(f, 1)) +
                       cp.bary(i, 2) * body_rest.row(F(f, 2));
-    bool pinched = false;
-    for (long j = 0; j < B.rows() && !pinched; ++j)
-      pinched = (B.row(j) - X.row(i)).squaredNorm() < reach2 &&
-                (body_rest.row(j) - rest.transpose()).squaredNorm() > sep2;
-    if (pinched)
+    auto other_part = [&](int g) {  // every corner of g was farther than pinch_separation at rest
+      for (int k = 0; k < 3; ++k)
+        if ((body_rest.row(F(g, k)) - rest.transpose()).squaredNorm() <= sep2) return false;
+      return true;
+    };
+    if (body.any_face_within(X.row(i).transpose(), opt.pinch_reach, other_part))
       d.pinched = std::max(d.pinched, depth);
     else
       d.free = std::max(d.free, depth);

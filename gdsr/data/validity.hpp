@@ -9,13 +9,12 @@
 //     longer than tear_stretch times it (a few dragged-out vertices that the means hide);
 //   - body: penetration depth = -signed distance to the body frame (Embree, exact closest
 //     point, gdsr/body/body_query.hpp), only when the dataset has a body; a penetrating
-//     vertex is "pinched" when a second body part is within pinch_reach of it (a body vertex
-//     farther than pinch_separation, in the first frame, from the closest point): cloth
-//     between a hand and a hip cannot be outside both, so pinched frames are counted apart
-//     (the second part is looked for at body vertices, 25 mm apart on average on the skinned
-//     bodies, so a part whose surface is within reach but whose nearest vertex is not is
-//     missed: skirt_pleated on salsa 61_03, the pinned waistband inside a hand that rests on
-//     the hip, hip vertex 50 mm away at frame 54, counts as outside pinches);
+//     vertex is "pinched" when the surface of a second body part is within pinch_reach of it
+//     (a body triangle whose corners were all farther than pinch_separation, in the first
+//     frame, from the closest point; Embree point query, exact distance): cloth between a hand
+//     and a hip cannot be outside both, so pinched frames are counted apart (the distance is
+//     to the surface, not to the part's vertices, which are 25 mm apart on average on the
+//     skinned bodies: there, a part whose surface was within reach could be missed);
 //     and the body's own crossings: frames where two body faces intersect (CGAL) whose
 //     vertices were all farther than pinch_separation apart in the first frame (two parts:
 //     a mocap forearm passing into the trunk; the skin creasing at a bent joint does not

@@ -1,10 +1,13 @@
 #include "gdsr/body/body.hpp"
 #include "gdsr/body/body_query.hpp"
+#include "gdsr/error.hpp"
+#include "gdsr/geometry/triangle.hpp"
 
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 
@@ -128,6 +131,35 @@ TEST_CASE("body_query: closest point and signed distance match brute force on a 
   // Smooth normal ~ radial direction on a sphere.
   const ClosestPoints r = BodyQuery(s).closest(Q);
   for (int i = 0; i < Q.rows(); ++i) CHECK(r.normal.row(i).dot(r.point.row(i).normalized()) > 0.99);
+}
+
+TEST_CASE("body_query: any_face_within agrees with brute force, only over accepted faces") {
+  // Random points near a sphere; the accepted faces are those with an even index. Brute force:
+  // the exact distance to every accepted triangle (closest_point_on_triangle), compared with
+  // the radius away from ties.
+  const TriMesh s = bq_icosphere(0.3, 2);
+  const BodyQuery bq(s);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-0.5, 0.5), R(0.001, 0.1);
+  auto even = [](int f) { return f % 2 == 0; };
+  int found = 0, missed = 0;
+  for (int i = 0; i < 400; ++i) {
+    const Vec3 q(U(rng), U(rng), U(rng));
+    const double radius = R(rng);
+    double best = std::numeric_limits<double>::infinity();
+    for (int f = 0; f < s.F.rows(); f += 2)
+      best = std::min(
+          best,
+          (closest_point_on_triangle(q, s.V.row(s.F(f, 0)), s.V.row(s.F(f, 1)), s.V.row(s.F(f, 2))).point - q).norm());
+    if (std::abs(best - radius) < 1e-9) continue;
+    const bool hit = bq.any_face_within(q, radius, even);
+    CHECK(hit == (best <= radius));
+    (hit ? found : missed)++;
+  }
+  CHECK(found > 25);  // both answers occur
+  CHECK(missed > 25);
+  CHECK_FALSE(bq.any_face_within(Vec3(0, 0, 0.3), 0.05, [](int) { return false; }));
+  CHECK_THROWS_AS(bq.any_face_within(Vec3(0, 0, NAN), 0.05, even), gdsr::Error);
 }
 
 TEST_CASE("body_query: signs at cube edges and corners") {

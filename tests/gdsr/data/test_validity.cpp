@@ -180,6 +180,38 @@ TEST_CASE("gdsr: validity counts penetration under a second body part as a pinch
   CHECK_THROWS_AS(gdsr::measure_validity(d, opt), gdsr::Error);
 }
 
+TEST_CASE("gdsr: validity finds a pinching part by its surface, not its vertices") {
+  // As above, but the second part is a broad plate (a hip under a resting hand): 0.6 m square,
+  // 1 cm above the sheet in frame 2, its corners 0.3 m or more from the deepest vertex, beyond
+  // the 4 cm reach. Its surface is within reach, so frame 2 is a pinch frame all the same.
+  const std::vector<double> top = {0.001, 0.004, 0.008, 0.003};
+  gdsr::Dataset d = stretched_dataset(top);
+  const gdsr::TriMesh far = box(1.0, 1.6, -0.15, 0.45, 0.01, 0.05), near = box(-0.15, 0.45, -0.15, 0.45, 0.01, 0.05);
+  gdsr::Faces F(d.body_faces.rows() * 2, 3);
+  F << d.body_faces, (far.F.array() + 8).matrix();
+  d.body_faces = F;
+  for (size_t t = 0; t < d.body_frames.size(); ++t) {
+    Points3 V(16, 3);
+    V << d.body_frames[t], (t == 2 ? near : far).V;
+    d.body_frames[t] = V;
+  }
+  // The yardstick's premise: no vertex of the plate is within reach of the sheet's deepest point.
+  const double nearest_corner = (near.V.rowwise() - Eigen::RowVector3d(0.165, 0.15, 0)).rowwise().norm().minCoeff();
+  REQUIRE(nearest_corner > 0.2);
+  gdsr::ValidityOptions opt;
+  opt.penetration_limit = 0.0035;
+  const gdsr::ValidityFigures v = gdsr::measure_validity(d, opt);
+  CHECK(v.lr.pinch_frames == 1);
+  CHECK(v.lr.frames_over_limit_free == 1);  // frame 1 (4 mm), the plate 1 m away
+  CHECK(v.lr.max_penetration_free == doctest::Approx(0.004).epsilon(1e-9));
+  CHECK(v.hr.pinch_frames == 1);
+  // The LR vertex is 1 cm under the plate: a reach just short of it finds no pinch.
+  opt.pinch_reach = 0.0099;
+  CHECK(gdsr::measure_validity(d, opt).lr.pinch_frames == 0);
+  opt.pinch_reach = 0.0101;
+  CHECK(gdsr::measure_validity(d, opt).lr.pinch_frames == 1);
+}
+
 TEST_CASE("gdsr: validity counts the frames where the body crosses itself, and the pinches among them") {
   // The rising box of the tests above plus two more parts, 0.4-0.5 m away in frame 0: a "hand"
   // that hovers 1 cm above the sheet in frame 2 (a pinch, the body not crossing itself), and an
