@@ -66,6 +66,7 @@ struct MakeArgs {
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN,
          compression_exponent = NAN, self_slack = NAN;
   double self_slack_per_pd = NAN, untangle_step = NAN, max_push_step = NAN, pinch_separation = NAN;
+  double contact_travel = NAN;
   double track_rate = NAN;  // 1/s: the HR simulation follows the LR one at the LR scale (sim/cloth_tracking.hpp)
   bool self_collision = true;
   bool limbs_pass_through = true;
@@ -190,6 +191,7 @@ void run_make(const MakeArgs& a) {
   if (a.stretch_passes > 0) params.stretch_passes = a.stretch_passes;
   if (a.settle_frames >= 0) params.settle_frames = a.settle_frames;
   if (a.contact_every > 0) params.contact_every = a.contact_every;
+  if (!std::isnan(a.contact_travel)) params.contact_travel = a.contact_travel;
   if (!std::isnan(a.friction)) params.friction = a.friction;
   if (!std::isnan(a.bend_stiffness)) params.bend_stiffness = a.bend_stiffness;
   if (!std::isnan(a.self_thickness)) params.self_thickness = a.self_thickness;
@@ -250,6 +252,7 @@ void run_make(const MakeArgs& a) {
                   {"damping_1_s", params.damping},
                   {"settle_frames", params.settle_frames},
                   {"contact_every", params.contact_every},
+                  {"contact_travel", params.contact_travel},
                   {"settle_damping_1_s", params.settle_damping},
                   {"settle_rest_blend", params.settle_rest_blend},
                   {"hr_start", hr_start_name(a)},
@@ -689,6 +692,11 @@ void add_data_command(CLI::App& app) {
   make->add_option("--contact-every", mk->contact_every,
                    "substeps between body contact refreshes (default: the solver's)")
       ->check(CLI::Range(1, 1000));
+  make->add_option(
+          "--contact-travel", mk->contact_travel,
+          "the body contact search reaches this many times the distance a vertex travels until the next "
+          "refresh beyond the fixed radius (default: the solver's, 1; 0: the fixed radius, solver revision 22)")
+      ->check(finite_range(0.0, 10.0));
   make->add_option("--settle-frames", mk->settle_frames,
                    "frames of damped motion on the first pose before frame 0 (default: the solver's)")
       ->check(CLI::Range(0, 1000));

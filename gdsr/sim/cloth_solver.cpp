@@ -53,6 +53,8 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
   if (m.FUV.rows() != m.F.rows()) gdsr::fail("sim/cloth_solver", "garment F and FUV differ in face count");
   if (p.substeps < 1 || p.iterations < 1 || p.contact_every < 1 || p.stretch_passes < 1)
     gdsr::fail("sim/cloth_solver", "substeps, iterations, stretch_passes and contact_every must be >= 1");
+  if (!(p.contact_travel >= 0) || !std::isfinite(p.contact_travel))
+    gdsr::fail("sim/cloth_solver", "contact_travel must be finite and >= 0");
   if (!(p.density > 0) || !(p.stretch_stiffness > 0) || !(p.bend_stiffness > 0))
     gdsr::fail("sim/cloth_solver", "density and stiffnesses must be positive");
   if (!(p.settle_rest_blend >= 0 && p.settle_rest_blend <= 1))
@@ -301,11 +303,12 @@ void ClothSolver::pass_limbs_through(const std::vector<Contact>& pierced, std::v
   for (int v = 0; v < nv; ++v) remembered_ += lost_in_.row(v).allFinite();
 }
 
-void ClothSolver::refresh_contacts(const Points3& body_now) {
+void ClothSolver::refresh_contacts(const Points3& body_now, double h) {
   contacts_.clear();
   const int nv = static_cast<int>(x_.rows());
   if (bodyF_.rows() > 0) {
     const double r = p_.thickness + p_.contact_radius;
+    const double until_next = p_.contact_travel * h * p_.contact_every;  // seconds of travel covered
     const double sep2 = p_.pinch_separation * p_.pinch_separation;
     // Up to two contacts per vertex, found in parallel (each vertex fills its own slots),
     // then gathered in vertex order, so the result does not depend on the thread count.
@@ -321,7 +324,14 @@ void ClothSolver::refresh_contacts(const Points3& body_now) {
     for (int v = 0; v < nv; ++v) {
       if (winv_[v] == 0) continue;
       const Vec3 x = x_.row(v).transpose();
-      const SurfaceHit a = grid_.closest(x, body_now, r);
+      // Nothing within the fixed radius: farther, a surface the vertex approaches fast enough to be
+      // within that radius by the next refresh (the body's own motion is left to the radius).
+      SurfaceHit a = grid_.closest(x, body_now, r);
+      const double travel = until_next * v_.row(v).norm();
+      if (a.face < 0 && travel > 0) {
+        a = grid_.closest(x, body_now, r + travel);
+        if (a.face >= 0 && a.signed_distance + until_next * v_.row(v).dot(a.normal) > r) continue;
+      }
       if (a.face < 0) continue;
       const Vec3 ra = bary_point(body_rest_, bodyF_, a.face, a.bary);
       const bool dressed = home_.row(v).allFinite();
@@ -690,9 +700,9 @@ void ClothSolver::step(const Points3& body_from, const Points3& body_to, double 
       body_prev = body_now;
       const double a = static_cast<double>(s + 1) / n;
       body_now = (1 - a) * body_from + a * body_to;
-      if (s % p_.contact_every == 0) refresh_contacts(body_prev);
+      if (s % p_.contact_every == 0) refresh_contacts(body_prev, h);
     } else if (s % p_.contact_every == 0) {
-      refresh_contacts(body_now);
+      refresh_contacts(body_now, h);
     }
     track_guide(static_cast<double>(s) / n, dt, h);
     detect_self_contacts(h);

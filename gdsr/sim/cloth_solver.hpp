@@ -4,7 +4,8 @@
 // distance), isometric
 // bending (Bergou et al. 2006, flat rest state; by default solved implicitly, see
 // sim/cloth_bending_solve.hpp), body contact with thickness and Coulomb
-// friction against the moving body (closest body triangle, refreshed every few substeps,
+// friction against the moving body (closest body triangle, refreshed every few substeps and
+// searched as far as the cloth travels until the next refresh,
 // body velocity from the frame blend; where a second body part is within reach, both, the
 // part the vertex was dressed on last, see pinch_separation), pinned bands (a waistband) moving
 // rigidly with the body under them (sim/cloth_pins.hpp),
@@ -144,7 +145,9 @@ namespace sim {
 //     SelfCollision::redetect); the other pairs keep their sides and reaches, where before every
 //     pair was found again. Datasets byte-identical to revision 21's on pants and skirt_pleated,
 //     salsa 61_03 (2-3 s); LR 0.13 -> 0.08 s per frame (pants), HR 0.90 -> 0.80 (skirt_pleated).
-inline constexpr int kSolverRevision = 22;
+// 23: the body contact search reaches as far as the cloth travels until the next refresh
+//     (SimParams::contact_travel): fast cloth makes its contacts before it enters the body.
+inline constexpr int kSolverRevision = 23;
 
 struct SimParams {
   int substeps = 20;                // per body frame
@@ -195,6 +198,13 @@ struct SimParams {
   double layer_gap = 0.004;                      // m, outer layer kept this far outside the inner layer
   double contact_radius = 0.03;                  // m, body search radius beyond thickness
   int contact_every = 5;                         // substeps between contact refreshes
+  double contact_travel = 1;  // the contact search reaches beyond thickness + contact_radius by this many times the
+                              // distance the vertex travels (its speed) until the next refresh, for a surface it
+                              // approaches fast enough to come within that radius by then: cloth that covered the
+                              // radius and max_push together between two refreshes entered the body unseen and,
+                              // deeper than max_push, stayed inside (a tier of skirt_tiered, spinning on salsa 61_03,
+                              // 55.6 mm inside a thigh for 40 frames; revision 23 has the figures). The body's own
+                              // motion is not added: it is left to the radius. 0: the fixed radius (revision 22)
   double max_push = 0.02;                        // m, vertices deeper than this inside the body are not pushed out
   double contact_release_stretch = 1.5;  // a body contact whose push would leave an edge of the vertex longer than this
                                          // times its rest length (and longer than before) lets the cloth slip instead:
@@ -399,7 +409,8 @@ class ClothSolver {
     gdsr::Vec3 normal;
   };
 
-  void refresh_contacts(const gdsr::Points3& body_now);
+  // h: the substep, seconds (the search reaches as far as the cloth travels until the next refresh).
+  void refresh_contacts(const gdsr::Points3& body_now, double h);
   // Whether contact c is with the body part around `part` (within pinch_separation of it in the first pose).
   bool in_part(const Contact& c, const gdsr::Vec3& part) const;
   // The contacts of vertex u with the body part around `part` (body points within
