@@ -59,6 +59,18 @@ gdsr::Dataset stretched_dataset(const std::vector<double>& top) {
   return d;
 }
 
+// Adds a second body box to d's box body: `far` in every frame but frame 2, `near` there.
+void add_second_part(gdsr::Dataset& d, const gdsr::TriMesh& far, const gdsr::TriMesh& near) {
+  gdsr::Faces F(d.body_faces.rows() * 2, 3);
+  F << d.body_faces, (far.F.array() + 8).matrix();
+  d.body_faces = F;
+  for (size_t t = 0; t < d.body_frames.size(); ++t) {
+    Points3 V(16, 3);
+    V << d.body_frames[t], (t == 2 ? near : far).V;
+    d.body_frames[t] = V;
+  }
+}
+
 }  // namespace
 
 TEST_CASE("gdsr: validity figures of a stretched, lifted sheet over a rising box are the closed-form ones") {
@@ -145,14 +157,7 @@ TEST_CASE("gdsr: validity counts penetration under a second body part as a pinch
   const std::vector<double> top = {0.001, 0.004, 0.008, 0.003};
   gdsr::Dataset d = stretched_dataset(top);
   const gdsr::TriMesh far = box(0.6, 0.65, 0.13, 0.17, 0.01, 0.05), near = box(0.14, 0.19, 0.13, 0.17, 0.01, 0.05);
-  gdsr::Faces F(d.body_faces.rows() * 2, 3);
-  F << d.body_faces, (far.F.array() + 8).matrix();
-  d.body_faces = F;
-  for (size_t t = 0; t < d.body_frames.size(); ++t) {
-    Points3 V(16, 3);
-    V << d.body_frames[t], (t == 2 ? near : far).V;
-    d.body_frames[t] = V;
-  }
+  add_second_part(d, far, near);
   gdsr::ValidityOptions opt;
   opt.penetration_limit = 0.0035;
   const gdsr::ValidityFigures v = gdsr::measure_validity(d, opt);
@@ -187,14 +192,7 @@ TEST_CASE("gdsr: validity finds a pinching part by its surface, not its vertices
   const std::vector<double> top = {0.001, 0.004, 0.008, 0.003};
   gdsr::Dataset d = stretched_dataset(top);
   const gdsr::TriMesh far = box(1.0, 1.6, -0.15, 0.45, 0.01, 0.05), near = box(-0.15, 0.45, -0.15, 0.45, 0.01, 0.05);
-  gdsr::Faces F(d.body_faces.rows() * 2, 3);
-  F << d.body_faces, (far.F.array() + 8).matrix();
-  d.body_faces = F;
-  for (size_t t = 0; t < d.body_frames.size(); ++t) {
-    Points3 V(16, 3);
-    V << d.body_frames[t], (t == 2 ? near : far).V;
-    d.body_frames[t] = V;
-  }
+  add_second_part(d, far, near);
   // The yardstick's premise: no vertex of the plate is within reach of the sheet's deepest point.
   const double nearest_corner = (near.V.rowwise() - Eigen::RowVector3d(0.165, 0.15, 0)).rowwise().norm().minCoeff();
   REQUIRE(nearest_corner > 0.2);
