@@ -59,14 +59,14 @@ gdsr::Dataset stretched_dataset(const std::vector<double>& top) {
   return d;
 }
 
-// Adds a second body box to d's box body: `far` in every frame but frame 2, `near` there.
-void add_second_part(gdsr::Dataset& d, const gdsr::TriMesh& far, const gdsr::TriMesh& near) {
+// Adds a second body box to d's box body: `far` in every frame but `frame`, `near` there.
+void add_second_part(gdsr::Dataset& d, const gdsr::TriMesh& far, const gdsr::TriMesh& near, size_t frame = 2) {
   gdsr::Faces F(d.body_faces.rows() * 2, 3);
   F << d.body_faces, (far.F.array() + 8).matrix();
   d.body_faces = F;
   for (size_t t = 0; t < d.body_frames.size(); ++t) {
     Points3 V(16, 3);
-    V << d.body_frames[t], (t == 2 ? near : far).V;
+    V << d.body_frames[t], (t == frame ? near : far).V;
     d.body_frames[t] = V;
   }
 }
@@ -384,15 +384,7 @@ TEST_CASE("gdsr: validity counts the frames where cloth is threaded on a body pa
   gdsr::Dataset d = stretched_dataset({-0.01, -0.01, -0.01});
   auto with_forearm = [&](double x0, double x1) {
     gdsr::Dataset e = d;
-    const gdsr::TriMesh near = box(x0, x1, 0.065, 0.085, -0.02, 0.02), far = box(0.6, 0.65, 0.065, 0.085, -0.02, 0.02);
-    gdsr::Faces F(24, 3);
-    F << d.body_faces, (far.F.array() + 8).matrix();
-    e.body_faces = F;
-    for (size_t t = 0; t < e.body_frames.size(); ++t) {
-      Points3 V(16, 3);
-      V << d.body_frames[t], (t == 1 ? near : far).V;
-      e.body_frames[t] = V;
-    }
+    add_second_part(e, box(0.6, 0.65, 0.065, 0.085, -0.02, 0.02), box(x0, x1, 0.065, 0.085, -0.02, 0.02), 1);
     return e;
   };
   const gdsr::Dataset threaded = with_forearm(0.05, 0.075);
