@@ -67,6 +67,7 @@ struct MakeArgs {
          compression_exponent = NAN, self_slack = NAN;
   double self_slack_per_pd = NAN, untangle_step = NAN, max_push_step = NAN, pinch_separation = NAN;
   double contact_travel = NAN;
+  double pin_yield_rate = NAN;
   double track_rate = NAN;  // 1/s: the HR simulation follows the LR one at the LR scale (sim/cloth_tracking.hpp)
   bool self_collision = true;
   bool limbs_pass_through = true;
@@ -192,6 +193,7 @@ void run_make(const MakeArgs& a) {
   if (a.settle_frames >= 0) params.settle_frames = a.settle_frames;
   if (a.contact_every > 0) params.contact_every = a.contact_every;
   if (!std::isnan(a.contact_travel)) params.contact_travel = a.contact_travel;
+  if (!std::isnan(a.pin_yield_rate)) params.pin_yield_rate = a.pin_yield_rate;
   if (!std::isnan(a.friction)) params.friction = a.friction;
   if (!std::isnan(a.bend_stiffness)) params.bend_stiffness = a.bend_stiffness;
   if (!std::isnan(a.self_thickness)) params.self_thickness = a.self_thickness;
@@ -253,6 +255,7 @@ void run_make(const MakeArgs& a) {
                   {"settle_frames", params.settle_frames},
                   {"contact_every", params.contact_every},
                   {"contact_travel", params.contact_travel},
+                  {"pin_yield_rate_1_s", params.pin_yield_rate},
                   {"settle_damping_1_s", params.settle_damping},
                   {"settle_rest_blend", params.settle_rest_blend},
                   {"hr_start", hr_start_name(a)},
@@ -697,6 +700,10 @@ void add_data_command(CLI::App& app) {
           "the body contact search reaches this many times the distance a vertex travels until the next "
           "refresh beyond the fixed radius (default: the solver's, 1; 0: the fixed radius, solver revision 22)")
       ->check(finite_range(0.0, 10.0));
+  make->add_option("--pin-yield-rate", mk->pin_yield_rate,
+                   "1/s: a body part other than the one a pin was dressed on may press the pin off its band, "
+                   "and it returns at this rate (default: the solver's, 0: rigid pins; one-layer garments only)")
+      ->check(finite_range(0.0, 1000.0));
   make->add_option("--settle-frames", mk->settle_frames,
                    "frames of damped motion on the first pose before frame 0 (default: the solver's)")
       ->check(CLI::Range(0, 1000));

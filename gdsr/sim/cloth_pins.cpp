@@ -153,11 +153,12 @@ void PinBinding::fit(int b, const Points3& body, Eigen::Matrix3d& R, Vec3& centr
   R = svd.matrixV() * D * svd.matrixU().transpose();
 }
 
-void PinBinding::place(const Points3& body, Points3& x) const {
+void PinBinding::place(const Points3& body, Points3& x, std::vector<Eigen::Matrix3d>* rotations) const {
   std::vector<Eigen::Matrix3d> R(bands_.size());
   std::vector<Vec3> c(bands_.size());
   for (size_t b = 0; b < bands_.size(); ++b) fit(static_cast<int>(b), body, R[b], c[b]);
   for (const Pin& p : pins_) x.row(p.v) = (c[p.band] + R[p.band] * p.offset0).transpose();
+  if (rotations) *rotations = std::move(R);
 }
 
 Vec3 PinBinding::position(int k, const Points3& body) const {

@@ -20,7 +20,8 @@
 // hip there). Frames with cloth > 5 mm inside the body outside pinches fell 47 -> 24, but 16
 // frames had an edge longer than 2x its pattern (none before), 23 had cloth threaded on the
 // body (none), 96.3% were free of self-intersections (99.3%), and the picture still showed the
-// hand through the yoke below the band.
+// hand through the yoke below the band. SimParams::pin_yield_rate (opt-in) presses a pin from its
+// first contact with the part on, never from inside it.
 //
 // Units: metres. Deterministic (fixed orders, no threads).
 #pragma once
@@ -45,7 +46,9 @@ class PinBinding {
   int num_bands() const { return static_cast<int>(bands_.size()); }
   // Writes every pin's position on body pose `body` (same vertex count as body_V0) into its
   // row of x (cloth vertices x 3); on body_V0 itself these are the placed positions to rounding.
-  void place(const gdsr::Points3& body, gdsr::Points3& x) const;
+  // rotations, if given: each band's rotation on `body` (on body_V0 the identity, to rounding), the
+  // frame a pin's offset from its band turns with.
+  void place(const gdsr::Points3& body, gdsr::Points3& x, std::vector<Eigen::Matrix3d>* rotations = nullptr) const;
   // Position of pin k alone (tests, diagnostics).
   gdsr::Vec3 position(int k, const gdsr::Points3& body) const;
   // Band of pin k and the body vertices that carry that band.

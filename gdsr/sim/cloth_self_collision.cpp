@@ -656,7 +656,8 @@ int SelfCollision::untangle(Points3& x, const std::vector<double>& winv, double 
   return crossing;
 }
 
-int SelfCollision::project(Points3& x, const std::vector<double>& winv, double thickness, double max_crossed_push) {
+int SelfCollision::project(Points3& x, const std::vector<double>& winv, double thickness, double max_crossed_push,
+                           double min_mass_share) {
   int pushed = 0;
   for (auto& c : vt_) {
     const int ia = F_(c.f, 0), ib = F_(c.f, 1), ic = F_(c.f, 2);
@@ -672,7 +673,8 @@ int SelfCollision::project(Points3& x, const std::vector<double>& winv, double t
     const double C = std::max(c.side * dist - thickness, -max_crossed_push);
     if (C >= 0) continue;
     const double wp = winv[c.v], wa = winv[ia], wb = winv[ib], wc = winv[ic];
-    const double wsum = wp + bary.x() * bary.x() * wa + bary.y() * bary.y() * wb + bary.z() * bary.z() * wc;
+    const double wsum = std::max(wp + bary.x() * bary.x() * wa + bary.y() * bary.y() * wb + bary.z() * bary.z() * wc,
+                                 min_mass_share * std::max({wp, wa, wb, wc}));
     if (!(wsum > 0)) continue;
     const Vec3 dir = (-C / wsum * c.side) * n;
     x.row(c.v) += (wp * dir).transpose();
@@ -707,7 +709,8 @@ int SelfCollision::project(Points3& x, const std::vector<double>& winv, double t
       c.set_dir(n);
     }
     const double w0 = winv[i0], w1 = winv[i1], w2 = winv[j0], w3 = winv[j1];
-    const double wsum = (1 - s) * (1 - s) * w0 + s * s * w1 + (1 - t) * (1 - t) * w2 + t * t * w3;
+    const double wsum = std::max((1 - s) * (1 - s) * w0 + s * s * w1 + (1 - t) * (1 - t) * w2 + t * t * w3,
+                                 min_mass_share * std::max({w0, w1, w2, w3}));
     if (!(wsum > 0)) continue;
     const Vec3 step = (-C / wsum) * n;
     x.row(i0) += (w0 * (1 - s) * step).transpose();

@@ -78,9 +78,13 @@ class SelfCollision {
   // `thickness` apart along the triangle normal / edge-edge normal, by inverse masses winv
   // (0 = fixed), by at most `max_crossed_push` metres: set it to `thickness` or more, and it
   // limits only pairs found crossed (on the other side from the one they were detected on,
-  // within their reach). Returns the number of pairs that were pushed.
+  // within their reach). min_mass_share: a pair's generalised inverse mass is taken as at least
+  // this fraction of its largest vertex's inverse mass, so that where the only free vertices carry
+  // little of the contact point (the others pinned) the push does not move them by C over their
+  // weight; pairs of free vertices of like masses are never below 0.25 (a vertex against a free
+  // face: 1 + 1/3 and more; two free edges: 1 and more). Returns the number of pairs pushed.
   int project(gdsr::Points3& x, const std::vector<double>& winv, double thickness,
-              double max_crossed_push = std::numeric_limits<double>::infinity());
+              double max_crossed_push = std::numeric_limits<double>::infinity(), double min_mass_share = 0);
 
   // One step of intersection contour minimisation over the edge-face crossings of the last
   // tangle test that still cross in x: the edge and the face are moved apart (by inverse

@@ -55,6 +55,8 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     gdsr::fail("sim/cloth_solver", "substeps, iterations, stretch_passes and contact_every must be >= 1");
   if (!(p.contact_travel >= 0) || !std::isfinite(p.contact_travel))
     gdsr::fail("sim/cloth_solver", "contact_travel must be finite and >= 0");
+  if (!(p.pin_yield_rate >= 0) || !std::isfinite(p.pin_yield_rate))
+    gdsr::fail("sim/cloth_solver", "pin_yield_rate must be finite and >= 0");
   if (!(p.density > 0) || !(p.stretch_stiffness > 0) || !(p.bend_stiffness > 0))
     gdsr::fail("sim/cloth_solver", "density and stiffnesses must be positive");
   if (!(p.settle_rest_blend >= 0 && p.settle_rest_blend <= 1))
@@ -170,7 +172,19 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
       winv_[v] = 0;
     }
     pins_ = PinBinding(g.pinned, placed, F_, bodyF_, body_V0);
-    place_pins(body_V0);
+    // A layered garment's pins stay rigid (SimParams::pin_yield_rate says why).
+    const bool layered = !layer_.empty() && *std::max_element(layer_.begin(), layer_.end()) > 0;
+    if (p.pin_yield_rate > 0 && !layered) {
+      pin_of_.assign(nv, -1);
+      pin_offset_ = Points3::Zero(pins_.size(), 3);
+      pin_room_.assign(pins_.size(), 0.0);
+      for (int k = 0; k < pins_.size(); ++k) {
+        const int v = pins_.vertex(k);
+        pin_of_[v] = k;
+        if (home_.row(v).allFinite()) pin_room_[k] = std::max(0.0, (x_.row(v) - home_.row(v)).norm() - p.thickness);
+      }
+    }
+    place_pins(body_V0, 0);
   }
   if (p.implicit_bending && !bends_.empty()) {
     std::vector<BendStencil> stencils;
@@ -241,8 +255,15 @@ void ClothSolver::set_rest_blend(double a) {
     tethers_[c].rest = tether_rest_placed_[c] + a * (tether_rest_pattern_[c] - tether_rest_placed_[c]);
 }
 
-void ClothSolver::place_pins(const Points3& body) {
-  pins_.place(body, x_);
+void ClothSolver::place_pins(const Points3& body, double h) {
+  pins_.place(body, x_, pin_of_.empty() ? nullptr : &band_rotation_);
+  if (pin_of_.empty()) return;
+  const double decay = std::exp(-p_.pin_yield_rate * h);
+  for (int k = 0; k < pins_.size(); ++k) {
+    if (pin_offset_.row(k).isZero(0)) continue;
+    pin_offset_.row(k) *= decay;
+    x_.row(pins_.vertex(k)) += (band_rotation_[pins_.band(k)] * pin_offset_.row(k).transpose()).transpose();
+  }
 }
 
 bool ClothSolver::in_part(const Contact& c, const Vec3& part) const {
@@ -320,9 +341,21 @@ void ClothSolver::refresh_contacts(const Points3& body_now, double h) {
       // the cloth, so leave it.
       if (hit.signed_distance > -p_.max_push) found[v][count[v]++] = {v, hit.face, hit.bary};
     };
+    auto foreign_to = [&](const Vec3& home) {  // faces of parts other than the one around `home`
+      return [this, home, sep2](int f) {
+        for (int k = 0; k < 3; ++k)
+          if ((body_rest_.row(bodyF_(f, k)).transpose() - home).squaredNorm() <= sep2) return false;
+        return true;
+      };
+    };
 #pragma omp parallel for schedule(dynamic, 256)
     for (int v = 0; v < nv; ++v) {
-      if (winv_[v] == 0) continue;
+      if (winv_[v] == 0) {  // a pin: only a part it was not dressed on may press it (pin_yield_rate)
+        if (pin_of_.empty() || pin_of_[v] < 0 || !(pin_room_[pin_of_[v]] > 0)) continue;
+        const SurfaceHit b = grid_.closest(x_.row(v).transpose(), body_now, r, foreign_to(home_.row(v).transpose()));
+        if (b.face >= 0) add(v, b);
+        continue;
+      }
       const Vec3 x = x_.row(v).transpose();
       // Nothing within the fixed radius: farther, a surface the vertex approaches fast enough to be
       // within that radius by the next refresh (the body's own motion is left to the radius).
@@ -347,11 +380,7 @@ void ClothSolver::refresh_contacts(const Points3& body_now, double h) {
         add(v, a);
         continue;
       }
-      const SurfaceHit b = grid_.closest(x, body_now, r, [&](int f) {
-        for (int k = 0; k < 3; ++k)
-          if ((body_rest_.row(bodyF_(f, k)).transpose() - ra).squaredNorm() <= sep2) return false;
-        return true;
-      });
+      const SurfaceHit b = grid_.closest(x, body_now, r, foreign_to(ra));
       if (b.face < 0) {
         add(v, a);
         continue;
@@ -605,6 +634,16 @@ void ClothSolver::solve_body_contacts(const Points3& body_prev, const Points3& b
     const Vec3 q = bary_point(body_now, bodyF_, c.face, c.bary);
     const Vec3 nrm = face_normal(body_now, bodyF_, c.face);
     Vec3 x = x_.row(c.v).transpose();
+    if (winv_[c.v] == 0) {  // a pin pressed by a foreign part, as far as its room allows (pin_yield_rate)
+      const int pin = pin_of_[c.v];
+      const Vec3 offset = pin_offset_.row(pin).transpose() - C * band_rotation_[pins_.band(pin)].transpose() * nrm;
+      // Also when the part went through the cloth around it (passing): pressed no farther than its
+      // room, the band is not carried along.
+      if (offset.norm() > pin_room_[pin] || overstretched_at(c.v, x - C * nrm)) continue;
+      pin_offset_.row(pin) = offset.transpose();
+      x_.row(c.v) = (x - C * nrm).transpose();
+      continue;
+    }
     const Vec3 qprev = bary_point(body_prev, bodyF_, c.face, c.bary);
     if (c.passing && (q - qprev).dot(nrm) > 0) continue;  // a limb that went through it does not push it on
     const double push =
@@ -629,7 +668,12 @@ void ClothSolver::solve_self_contacts() {
   // vertices, and one Gauss-Seidel pass leaves them coupled.
   if (!self_) return;
   const double max_crossed_push = p_.self_crossed_push * p_.self_thickness;
-  for (int k = 0; k < p_.self_passes && self_->project(x_, winv_, p_.self_thickness, max_crossed_push) > 0; ++k) {
+  // Pins that a hand may press into the cloth (pin_yield_rate): their free partners are moved no
+  // more than C over a quarter (SelfCollision::project). Pushed by C over its weight, a vertex
+  // under the 10 mm pleated waistband was thrown 1.7 m in one pass.
+  const double min_mass_share = pin_of_.empty() ? 0.0 : 0.25;
+  for (int k = 0;
+       k < p_.self_passes && self_->project(x_, winv_, p_.self_thickness, max_crossed_push, min_mass_share) > 0; ++k) {
   }
 }
 
@@ -707,7 +751,7 @@ void ClothSolver::step(const Points3& body_from, const Points3& body_to, double 
     track_guide(static_cast<double>(s) / n, dt, h);
     detect_self_contacts(h);
     predict(h, decay);
-    if (has_body) place_pins(body_now);
+    if (has_body) place_pins(body_now, h);
     if (implicit_bending_) implicit_bending_->solve(h, x_);
     std::fill(lambda_e.begin(), lambda_e.end(), 0.0);
     classify_edges();

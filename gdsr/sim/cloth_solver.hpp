@@ -212,6 +212,25 @@ struct SimParams {
                               // 55.6 mm inside a thigh for 40 frames; revision 23 has the figures). The body's own
                               // motion is not added: it is left to the radius. 0: the fixed radius (revision 22)
   double max_push = 0.02;                        // m, vertices deeper than this inside the body are not pushed out
+  double pin_yield_rate = 0;  // 1/s; 0: rigid pins (the default). Above 0: a body part other than the one a pin was
+                              // dressed on (pinch_separation apart in the first pose: a hand on the hip) presses the
+                              // pin off its band, in the band's frame, by at most the pin's first-pose distance from
+                              // the body minus thickness (so not into the hip), and the pin returns to the band at
+                              // this rate; self-contact then moves the pin's free partners no more than C over a
+                              // quarter (SelfCollision::project's min_mass_share: pushed by C over its weight, a
+                              // vertex under the 10 mm band was thrown 1.7 m in one pass). Layered garments keep
+                              // rigid pins: an outer layer's pin pressed in went through the pinned inner ones
+                              // (skirt_tiered on salsa 61_03: a vertex thrown 0.4 m, 78% of LR frames free of
+                              // self-intersections), the innermost layer's alone changed nothing beyond the
+                              // chaotic spread. Not the default: at 5/s, skirt_pleated on salsa 61_03 (2-6 s),
+                              // friction 0.3 / 0.30001, frames with cloth > 5 mm inside the body outside pinches
+                              // fall at 30 mm (LR 46 / 47 -> 28 / 30, deepest 34.2 -> 30.8 mm, 100% of frames free
+                              // of self-intersections) and at 10 mm (HR 51 / 49 -> 35 / 35), but HR frames free of
+                              // self-intersections fall 100 / 100% -> 97.8 / 96.3%: the pressed band crosses the
+                              // pleats under it beside the hand (`data preview --frame 99 --intersections`), and
+                              // frames with LR cloth threaded on the body rise 0 / 0 -> 3 / 1. At 30 mm, before the
+                              // band's frame and the floor: skirt_short on 61_03 2 / 2 -> 1 / 0 frames inside; pants
+                              // on 61_03 1 -> 1 (8.9 -> 5.6 mm); skirt_pleated on walk 131_02 13 -> 12
   double contact_release_stretch = 1.5;  // a body contact whose push would leave an edge of the vertex longer than this
                                          // times its rest length (and longer than before) lets the cloth slip instead:
                                          // a hand sweeping past a pinned waistband (CMU salsa 61_02) otherwise dragged
@@ -430,7 +449,9 @@ class ClothSolver {
   // passing. Updates lost_in_.
   void pass_limbs_through(const std::vector<Contact>& pierced, std::vector<std::array<Contact, 2>>& found,
                           std::vector<signed char>& count);
-  void place_pins(const gdsr::Points3& body);
+  // Pins on their bands on pose `body`, plus the offset a foreign part pressed them by (decayed
+  // over h seconds at pin_yield_rate).
+  void place_pins(const gdsr::Points3& body, double h);
   // The steps of one substep of length h (seconds), in the order step() runs them.
   void detect_self_contacts(double h);
   bool redetect_self_contacts(double h);
@@ -459,6 +480,11 @@ class ClothSolver {
   std::vector<double> edge_scale_;  // per edge, this substep: compliance factor (1 stretched, 1/compression_ratio)
   std::vector<Bend> bends_;
   PinBinding pins_;
+  std::vector<int> pin_of_;   // per cloth vertex: its pin in pins_ (-1: none); only with pin_yield_rate > 0
+  gdsr::Points3 pin_offset_;  // per pin: m it is pressed off its band (SimParams::pin_yield_rate), in the
+                              // band's first-pose frame (a band turns a quarter turn in 0.2 s of a salsa spin)
+  std::vector<Eigen::Matrix3d> band_rotation_;  // per band of pins_, this substep
+  std::vector<double> pin_room_;  // per pin: m it may be pressed (stand-off from its home minus thickness)
   std::vector<Tether> tethers_;
   std::unique_ptr<ImplicitBending> implicit_bending_;
   std::vector<Contact> contacts_;

@@ -232,7 +232,8 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
                         " --compression-ratio 0.5 --compression-exponent 1.5 --settle-frames 3 --contact-every 2"
                         " --self-slack 0.002 --self-detect-every 3 --self-slack-per-pd 0.25 --self-passes 2"
                         " --no-limbs-pass-through --no-limbs-pass-until-clear --untangle-step 0.25 --no-self-redetect"
-                        " --track-rate 4 --max-push-step 0.01 --pinch-separation 0.08 --contact-travel 0");
+                        " --track-rate 4 --max-push-step 0.01 --pinch-separation 0.08 --contact-travel 0"
+                        " --pin-yield-rate 2.5");
   REQUIRE(mk.status == 0);
   const std::string manifest = gdsr_test::slurp(out + "/manifest.json");
   CHECK(manifest.find("\"iterations\": 3") != std::string::npos);
@@ -244,6 +245,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"settle_frames\": 3") != std::string::npos);
   CHECK(manifest.find("\"contact_every\": 2") != std::string::npos);
   CHECK(manifest.find("\"contact_travel\": 0") != std::string::npos);
+  CHECK(manifest.find("\"pin_yield_rate_1_s\": 2.5") != std::string::npos);
   CHECK(manifest.find("\"self_slack_m\": 0.002") != std::string::npos);
   CHECK(manifest.find("\"self_detect_every\": 3") != std::string::npos);
   CHECK(manifest.find("\"self_passes\": 2") != std::string::npos);
@@ -256,11 +258,13 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"max_push_step_m\": 0.01") != std::string::npos);
   CHECK(manifest.find("\"pinch_separation_m\": 0.08") != std::string::npos);
   CHECK(manifest.find("\"layer_gap_m\": 0.004") != std::string::npos);  // the infer layer offset's default
-  for (const std::string bad :
-       {"--iterations 0", "--friction -1", "--self-thickness 1", "--bend-stiffness -2", "--compression-ratio 0",
-        "--compression-exponent -1", "--compression-exponent 5", "--settle-frames -1", "--contact-every 0",
-        "--self-slack 0", "--self-detect-every 0", "--self-passes 0", "--self-slack-per-pd 0", "--untangle-step -0.1",
-        "--track-rate -1", "--track-rate nan", "--max-push-step 0", "--pinch-separation 0", "--contact-travel -1"}) {
+  for (const std::string bad : {"--iterations 0",           "--friction -1",         "--self-thickness 1",
+                                "--bend-stiffness -2",      "--compression-ratio 0", "--compression-exponent -1",
+                                "--compression-exponent 5", "--settle-frames -1",    "--contact-every 0",
+                                "--self-slack 0",           "--self-detect-every 0", "--self-passes 0",
+                                "--self-slack-per-pd 0",    "--untangle-step -0.1",  "--track-rate -1",
+                                "--track-rate nan",         "--max-push-step 0",     "--pinch-separation 0",
+                                "--contact-travel -1",      "--pin-yield-rate -1"}) {
     const Run r = gdsr_run(dir, "data make --out '" + (dir / "bad") + "' " + bad);
     CHECK(r.status == 1);  // a refusal, not a crash (a sanitizer report exits 99)
     CHECK(r.err.find(bad.substr(0, bad.find(' '))) != std::string::npos);

@@ -63,6 +63,14 @@ TEST_CASE("pins: on the placement pose each pin is at its placement, and a rigid
   CHECK(pins.support(0).size() >= 20);
   CHECK(at_rest < 1e-12);
   CHECK(rigid < 1e-12);
+  // The band's frame (a pressed pin's offset turns with it): the identity at rest, R moved.
+  Points3 x = g.mesh.V;
+  std::vector<Eigen::Matrix3d> frames;
+  pins.place(body.V, x, &frames);
+  REQUIRE(frames.size() == 1);
+  CHECK((frames[0] - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-12);
+  pins.place(moved, x, &frames);
+  CHECK((frames[0] - R).cwiseAbs().maxCoeff() < 1e-12);
 }
 
 namespace {
