@@ -701,8 +701,8 @@ void add_data_command(CLI::App& app) {
           "refresh beyond the fixed radius (default: the solver's, 1; 0: the fixed radius, solver revision 22)")
       ->check(finite_range(0.0, 10.0));
   make->add_option("--pin-yield-rate", mk->pin_yield_rate,
-                   "1/s: a body part other than the one a pin was dressed on may press the pin off its band, "
-                   "and it returns at this rate (default: the solver's, 0: rigid pins; one-layer garments only)")
+                   "1/s: a body part other than the one a pin was dressed on may press the pin towards the body, "
+                   "and it returns at this rate (default: the solver's, 5; 0: rigid pins; one-layer garments only)")
       ->check(finite_range(0.0, 1000.0));
   make->add_option("--settle-frames", mk->settle_frames,
                    "frames of damped motion on the first pose before frame 0 (default: the solver's)")

@@ -20,6 +20,10 @@ using gdsr::Vec3;
 
 namespace {
 
+// A pin is pressed towards its home only by a part pushing it that way at more than this cosine:
+// at a grazing angle a push of depth C moves the pin C over the cosine.
+constexpr double kMinPinPress = 0.2;
+
 double cot(const Vec2& a, const Vec2& b) {  // cotangent of the angle between a and b
   const double c = a.dot(b);
   const double s = std::abs(a.x() * b.y() - a.y() * b.x());
@@ -178,10 +182,14 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
       pin_of_.assign(nv, -1);
       pin_offset_ = Points3::Zero(pins_.size(), 3);
       pin_room_.assign(pins_.size(), 0.0);
+      pin_inward_ = Points3::Zero(pins_.size(), 3);
       for (int k = 0; k < pins_.size(); ++k) {
         const int v = pins_.vertex(k);
         pin_of_[v] = k;
-        if (home_.row(v).allFinite()) pin_room_[k] = std::max(0.0, (x_.row(v) - home_.row(v)).norm() - p.thickness);
+        if (!home_.row(v).allFinite()) continue;
+        const Vec3 in = (home_.row(v) - x_.row(v)).transpose();
+        pin_room_[k] = std::max(0.0, in.norm() - p.thickness);
+        if (pin_room_[k] > 0) pin_inward_.row(k) = in.normalized().transpose();
       }
     }
     place_pins(body_V0, 0);
@@ -634,14 +642,21 @@ void ClothSolver::solve_body_contacts(const Points3& body_prev, const Points3& b
     const Vec3 q = bary_point(body_now, bodyF_, c.face, c.bary);
     const Vec3 nrm = face_normal(body_now, bodyF_, c.face);
     Vec3 x = x_.row(c.v).transpose();
-    if (winv_[c.v] == 0) {  // a pin pressed by a foreign part, as far as its room allows (pin_yield_rate)
+    if (winv_[c.v] == 0) {  // a pin pressed by a foreign part towards its home, within its room (pin_yield_rate)
+      // Only towards the home (the hip under a hand): pressed along the hand's normal, the band slid
+      // over the folds hanging from it and crossed them (10 mm pleated skirt on salsa 61_03).
       const int pin = pin_of_[c.v];
-      const Vec3 offset = pin_offset_.row(pin).transpose() - C * band_rotation_[pins_.band(pin)].transpose() * nrm;
+      const Vec3 in = pin_inward_.row(pin).transpose();
+      const double along = (band_rotation_[pins_.band(pin)] * in).dot(nrm);  // depth undone per m pressed home
+      if (!(along > kMinPinPress)) continue;
+      const double pressed = pin_offset_.row(pin).dot(in.transpose());
+      const double t = std::min(-C / along, pin_room_[pin] - pressed);
+      const Vec3 moved = x + t * (band_rotation_[pins_.band(pin)] * in);
       // Also when the part went through the cloth around it (passing): pressed no farther than its
       // room, the band is not carried along.
-      if (offset.norm() > pin_room_[pin] || overstretched_at(c.v, x - C * nrm)) continue;
-      pin_offset_.row(pin) = offset.transpose();
-      x_.row(c.v) = (x - C * nrm).transpose();
+      if (!(t > 0) || overstretched_at(c.v, moved)) continue;
+      pin_offset_.row(pin) += t * in.transpose();
+      x_.row(c.v) = moved.transpose();
       continue;
     }
     const Vec3 qprev = bary_point(body_prev, bodyF_, c.face, c.bary);

@@ -153,7 +153,18 @@ namespace sim {
 //     100 / 86.0 / 94.9 / 98.5 -> 100 / 86.0% (the clip is chaotic). Byte-identical on 1 s of
 //     skirt_short (CMU 01_01), skirt_pleated and pants (salsa 61_03), and the t-shirt's LR (CMU
 //     01_03; its HR curvature 20.448 -> 20.447, every other figure the same); CPU time the same.
-inline constexpr int kSolverRevision = 23;
+// 24: pins a hand may press in are the default (SimParams::pin_yield_rate 5/s; garments of one
+//     layer), pressed towards their home only. 30 mm LR / 10 mm HR, 2-6 s, rigid -> 5/s: frames with
+//     cloth > 5 mm inside the body outside pinches, skirt_pleated on salsa 61_03 (friction 0.3 /
+//     0.30001) LR 46 / 47 -> 40 / 31, HR 51 / 49 -> 46 / 39; on salsa 60_03 LR 34 -> 19, HR 51 ->
+//     37 (deepest 27.0 -> 25.5 mm); frames free of self-intersections 100% at both resolutions in
+//     every run (revision 23's press along the hand's normal: HR 97.8 / 96.3% on 61_03). The
+//     deepest frame left on 61_03 (35.8 mm, frame 86) is a forearm sweeping along the band, which
+//     no press towards the hip undoes. Pants on salsa 61_03: LR frames free of self-intersections
+//     97.8 -> 100%, frames inside the body LR 1 -> 0, HR 4 -> 5 (deepest 44.3 -> 38.3 mm), HR frames
+//     with an edge > 2x its pattern 52 -> 48 (the crotch). skirt_short on CMU 01_01 (1-6 s) and 01_03
+//     (1-3 s), the demo's clips: byte-identical (no hand reaches the band).
+inline constexpr int kSolverRevision = 24;
 
 struct SimParams {
   int substeps = 20;                // per body frame
@@ -212,25 +223,19 @@ struct SimParams {
                               // 55.6 mm inside a thigh for 40 frames; revision 23 has the figures). The body's own
                               // motion is not added: it is left to the radius. 0: the fixed radius (revision 22)
   double max_push = 0.02;                        // m, vertices deeper than this inside the body are not pushed out
-  double pin_yield_rate = 0;  // 1/s; 0: rigid pins (the default). Above 0: a body part other than the one a pin was
-                              // dressed on (pinch_separation apart in the first pose: a hand on the hip) presses the
-                              // pin off its band, in the band's frame, by at most the pin's first-pose distance from
-                              // the body minus thickness (so not into the hip), and the pin returns to the band at
-                              // this rate; self-contact then moves the pin's free partners no more than C over a
-                              // quarter (SelfCollision::project's min_mass_share: pushed by C over its weight, a
-                              // vertex under the 10 mm band was thrown 1.7 m in one pass). Layered garments keep
-                              // rigid pins: an outer layer's pin pressed in went through the pinned inner ones
-                              // (skirt_tiered on salsa 61_03: a vertex thrown 0.4 m, 78% of LR frames free of
-                              // self-intersections), the innermost layer's alone changed nothing beyond the
-                              // chaotic spread. Not the default: at 5/s, skirt_pleated on salsa 61_03 (2-6 s),
-                              // friction 0.3 / 0.30001, frames with cloth > 5 mm inside the body outside pinches
-                              // fall at 30 mm (LR 46 / 47 -> 28 / 30, deepest 34.2 -> 30.8 mm, 100% of frames free
-                              // of self-intersections) and at 10 mm (HR 51 / 49 -> 35 / 35), but HR frames free of
-                              // self-intersections fall 100 / 100% -> 97.8 / 96.3%: the pressed band crosses the
-                              // pleats under it beside the hand (`data preview --frame 99 --intersections`), and
-                              // frames with LR cloth threaded on the body rise 0 / 0 -> 3 / 1. At 30 mm, before the
-                              // band's frame and the floor: skirt_short on 61_03 2 / 2 -> 1 / 0 frames inside; pants
-                              // on 61_03 1 -> 1 (8.9 -> 5.6 mm); skirt_pleated on walk 131_02 13 -> 12
+  double pin_yield_rate = 5;  // 1/s; 0: rigid pins (the default until revision 23). Above 0: a body part other than
+                              // the one a pin was dressed on (pinch_separation apart in the first pose: a hand on the
+                              // hip) presses the pin towards its home (its closest body point in the first pose, in
+                              // the band's frame) by at most the pin's first-pose distance from the body minus
+                              // thickness (so not into the hip), and the pin returns to the band at this rate;
+                              // self-contact then moves the pin's free partners no more than C over a quarter
+                              // (SelfCollision::project's min_mass_share: pushed by C over its weight, a vertex
+                              // under the 10 mm band was thrown 1.7 m in one pass). Towards the home only: pressed
+                              // along the part's normal (revision 23), the band slid over the pleats hanging from it
+                              // and crossed them. Layered garments keep rigid pins: an outer layer's pin pressed in
+                              // went through the pinned inner ones (skirt_tiered on salsa 61_03: a vertex thrown
+                              // 0.4 m, 78% of LR frames free of self-intersections), the innermost layer's alone
+                              // changed nothing beyond the chaotic spread. Measured in kSolverRevision 24.
   double contact_release_stretch = 1.5;  // a body contact whose push would leave an edge of the vertex longer than this
                                          // times its rest length (and longer than before) lets the cloth slip instead:
                                          // a hand sweeping past a pinned waistband (CMU salsa 61_02) otherwise dragged
@@ -485,6 +490,7 @@ class ClothSolver {
                               // band's first-pose frame (a band turns a quarter turn in 0.2 s of a salsa spin)
   std::vector<Eigen::Matrix3d> band_rotation_;  // per band of pins_, this substep
   std::vector<double> pin_room_;  // per pin: m it may be pressed (stand-off from its home minus thickness)
+  gdsr::Points3 pin_inward_;      // per pin: unit direction to its home, in the band's first-pose frame
   std::vector<Tether> tethers_;
   std::unique_ptr<ImplicitBending> implicit_bending_;
   std::vector<Contact> contacts_;
