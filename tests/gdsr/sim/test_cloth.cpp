@@ -318,7 +318,6 @@ double hand_through_sheet_carry(bool until_clear) {
   sim::SimParams p;
   p.limbs_pass_until_clear = until_clear;
   const auto rest = body_at(path[0]);
-  const gdsr::ClosestPoints home = gdsr::BodyQuery(gdsr::TriMesh{rest.V, rest.F}).closest(g.mesh.V, false, 0.2);
   sim::ClothSolver solver(g, rest.F, rest.V, p);
   double carried = 0;
   for (size_t t = 1; t < path.size(); ++t) {
