@@ -487,7 +487,8 @@ class ClothSolver {
   PinBinding pins_;
   std::vector<int> pin_of_;   // per cloth vertex: its pin in pins_ (-1: none); only with pin_yield_rate > 0
   gdsr::Points3 pin_offset_;  // per pin: m it is pressed off its band (SimParams::pin_yield_rate), in the
-                              // band's first-pose frame (a band turns a quarter turn in 0.2 s of a salsa spin)
+                              // band's first-pose frame (a band turns a quarter turn in 0.2 s of a salsa spin);
+                              // always along pin_inward_ (kept as a vector: revision 24 was measured so)
   std::vector<Eigen::Matrix3d> band_rotation_;  // per band of pins_, this substep
   std::vector<double> pin_room_;  // per pin: m it may be pressed (stand-off from its home minus thickness)
   gdsr::Points3 pin_inward_;      // per pin: unit direction to its home, in the band's first-pose frame
