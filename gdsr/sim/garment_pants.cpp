@@ -4,7 +4,8 @@
 // crotch the tubes blend into the hip cylinder. Above the hips a yoke, a cone frustum like a
 // short skirt's (garment_cone.hpp), narrows from the hip cylinder to the waist section, which
 // its waistband follows at its pattern length; it is sewn to the legs along the hip line.
-// Side seams, inseams and the hip seam; the waistband is pinned.
+// Side seams, inseams, a short crotch seam between the legs and the hip seam; the waistband
+// is pinned.
 #include "gdsr/sim/garment_cone.hpp"
 #include "gdsr/sim/garment_design.hpp"
 #include "gdsr/sim/garment_legs.hpp"
@@ -38,6 +39,10 @@ GarmentDesign design_pants(const BodyLandmarks& lm) {
   const double Hc = lm.crotch_y - 0.06 * s - hem_y;
   const double r_hem = 0.075 * s;
   const double g = std::max(0.02 * s, W / 2 - kPi * r_hem), blend = 0.10 * s;
+  // A curved crotch seam between the legs (radius c, garment_legs.hpp): with the notch ending
+  // in one vertex (c = 0) that vertex gathered 673 degrees of pattern angle, and the HR edges
+  // around it tore past 2x when salsa legs spread (3.4x on 61_03).
+  const double c = 0.03 * s;
   // The hip line: at the hips, but above the legs' blend into the hip cylinder.
   const double Ht = std::min(std::max(lm.hip_y - hem_y, Hc + blend), Htot - 0.04 * s);
   const double ease = 0.015 * s;
@@ -45,11 +50,11 @@ GarmentDesign design_pants(const BodyLandmarks& lm) {
   const Cone yoke(a, std::max(R, a + 0.01 * s), Htot - Ht);
   // Leg panels up to the hip line, whose edge is split like the yoke's lower arc (edges 5 .. 4 + n).
   const int n = std::max(8, static_cast<int>(std::ceil(kPi * yoke.b / 0.03)));
-  add_two_leg_panels(p, W, Ht, Hc, g, "pants", n);
+  const int top_edge = add_two_leg_panels(p, W, Ht, Hc, g, "pants", n, c);
   // The yoke (panels 2, 3): its lower arc's edge j (psi increasing) meets hip-line edge n - 1 - j.
   auto lay = std::make_shared<SkirtLayout>(add_cone_skirt(p, yoke, pattern_max_x(p) + 0.1, "pants_yoke", 0, {}, n));
   for (int k = 0; k < 2; ++k)
-    for (int j = 0; j < n; ++j) p.seams.push_back({2 + k, j, k, 5 + (n - 1 - j), true});
+    for (int j = 0; j < n; ++j) p.seams.push_back({2 + k, j, k, top_edge + (n - 1 - j), true});
   // Its waist fit fades out over the whole yoke, so that its lower arc is the hip circle.
   auto waist = std::make_shared<const WaistCurve>(lm, a, yoke.L);
   // Each leg tube is a tilted cone around the body leg's line (from `top` at the crotch
@@ -59,7 +64,10 @@ GarmentDesign design_pants(const BodyLandmarks& lm) {
   Vec3 top[2], dir[2], e1[2], e2[2];
   for (int k = 0; k < 2; ++k) {
     const double side = k == 0 ? 1.0 : -1.0;
-    top[k] = Vec3(side * R / 2, hem_y + Hc, 0);
+    // The crotch arc takes 2c from each leg's girth at the crotch: its tube, c / pi thinner
+    // there, is moved out by as much, so that its outer side still meets the hip cylinder
+    // (placed 5 mm inside the thighs of CMU 01_01 otherwise).
+    top[k] = Vec3(side * (R / 2 + c / kPi), hem_y + Hc, 0);
     const Vec3 dl = lm.leg_bottom[k] - lm.leg_top[k];
     Vec3 bot = lm.leg_top[k] + dl * ((hem_y - lm.leg_top[k].y()) / (dl.y() < -1e-6 ? dl.y() : -1.0)) - axis;
     bot.y() = hem_y;
@@ -71,18 +79,23 @@ GarmentDesign design_pants(const BodyLandmarks& lm) {
   const double waist_y = lm.waist_y;
   d.place = [=](int panel, const Vec2& uv) {
     if (panel >= 2) return place_cone(*lay, panel - 2, uv, axis, waist_y, waist.get());
-    const LegCoords lc = leg_coords(panel, uv, W, R, hem_y, Hc, g, blend);
+    const LegCoords lc = leg_coords(panel, uv, W, R, hem_y, Hc, g, blend, c);
     if (lc.on_hip) return Vec3(axis + lc.hip);
-    const double y = uv.y(), t = lc.t, r = lc.r, zs = lc.zs;
-    const int k = lc.leg;  // 3-D side of this leg
-    const double side = k == 0 ? 1.0 : -1.0;
-    const Vec3 c = top[k] + dir[k] * std::max(0.0, Hc - y);  // vertical above the crotch (blend zone)
-    // Cross-sections horizontal at the crotch (the two tubes touch only at the crotch point
-    // there), turning perpendicular to the leg line within the top quarter of the leg.
+    const double y = uv.y();
+    // Cross-sections horizontal at the crotch (the tubes' inseams 4c / pi apart there),
+    // turning perpendicular to the leg line within the top quarter of the leg.
     const double w = std::clamp((Hc - y) / (0.25 * Hc), 0.0, 1.0);
-    const Vec3 f1 = ((1 - w) * side * Vec3::UnitX() + w * e1[k]).normalized();
-    const Vec3 f2 = ((1 - w) * Vec3::UnitZ() + w * e2[k]).normalized();
-    const Vec3 leg = c + r * std::cos(kPi * t) * f1 + zs * r * std::sin(kPi * t) * f2;
+    auto tube = [&](int k, double t) {  // k: 3-D side of the leg
+      const double side = k == 0 ? 1.0 : -1.0;
+      const Vec3 centre = top[k] + dir[k] * std::max(0.0, Hc - y);  // at the crotch height above it
+      const Vec3 f1 = ((1 - w) * side * Vec3::UnitX() + w * e1[k]).normalized();
+      const Vec3 f2 = ((1 - w) * Vec3::UnitZ() + w * e2[k]).normalized();
+      return Vec3(centre + lc.r * std::cos(kPi * t) * f1 + lc.zs * lc.r * std::sin(kPi * t) * f2);
+    };
+    // The cloth over the crotch arc spans the gap between the two legs' inseams (the arc's
+    // pattern length, pi c, placed on 4c / pi: the settle eases it in).
+    const Vec3 leg =
+        lc.across > 0 ? Vec3((1 - lc.across) * tube(lc.leg, 1) + lc.across * tube(1 - lc.leg, 1)) : tube(lc.leg, lc.t);
     return Vec3(axis + (1 - lc.blend) * leg + lc.blend * lc.hip);
   };
   d.pinned = [lay](int panel, const Vec2& uv) {  // the yoke's waistband

@@ -150,7 +150,9 @@ TEST_CASE("garments: the paper's five garments rest outside the body, unstrained
       // No two triangles intersect (CGAL); -1 would mean a non-manifold or misoriented mesh.
       CHECK(self_intersections(m.V, m.F) == 0);
       // Rest strain against the flat pattern: developable pieces are isometric; the t-shirt's
-      // shoulder fold shears (E_uv) and the pants' crotch blend stretches (E_v) locally, and the
+      // shoulder fold shears (E_uv) and the pants' crotch blend stretches (E_v) locally (E_v
+      // 0.11 / 0.14 at 30 / 10 mm since the crotch arc, whose cloth is placed on 0.64x its
+      // width between the legs, 0.12 and less before), and the
       // pleated skirt's waistband, drawn in to the waist section, is gathered (E_v, E_uv
       // 0.015-0.021), and so is the dress's bodice, a frustum from the round waist seam to the
       // band fitted to the trunk (E_v, E_uv 0.018-0.020; the settle eases it). The cone skirts follow the waist section
@@ -163,7 +165,7 @@ TEST_CASE("garments: the paper's five garments rest outside the body, unstrained
       const bool cones = name != "tshirt" && name != "pants";
       CHECK(se.E_u < 0.005);
       const bool fitted = name == "skirt_pleated" || name == "dress_layered";
-      CHECK(se.E_v < (name == "pants" ? 0.12 : fitted ? 0.03 : 0.005));
+      CHECK(se.E_v < (name == "pants" ? 0.15 : fitted ? 0.03 : 0.005));
       CHECK(se.E_uv < (cones && !fitted ? 0.005 : fitted ? 0.03 : 0.07));
       // Layers exactly where the garment has them.
       const int layers = name == "dress_layered" ? 2 : name == "skirt_tiered" ? 3 : 1;
@@ -251,6 +253,38 @@ TEST_CASE("garments: the paper's garments also fit a salsa dancer's rest pose") 
     const auto g = sim::make_garment(name, 0.03, body);
     CHECK(query.closest(g.mesh.V).sdist.minCoeff() > -0.005);
     CHECK(self_intersections(g.mesh.V, g.mesh.F) == 0);
+  }
+}
+
+TEST_CASE("garments: the pants' crotch seam lies between the legs and spreads the crotch's pattern angle") {
+  // The notch between the legs ended in one vertex, around which front and back gathered 673
+  // degrees of pattern angle (a flat vertex has 360); when salsa legs spread, HR edges there
+  // tore past 2x (3.4x on 61_03). Ending the notch in a half-circle, a crotch seam between the
+  // legs, shares the excess out along the arc's corners: 450 degrees at each (two panels turning
+  // 45 each). A straight seam 6 cm long would leave 523 at each end.
+  const gdsr::TriMesh body = rest_for("pants", "/usr/share/assimp/models/BVH/01_01.bvh");
+  const auto lm = sim::measure_body(body);
+  for (const double pd : {0.03, 0.01}) {
+    CAPTURE(pd);
+    const auto g = sim::make_garment("pants", pd, body);
+    const auto& m = g.mesh;
+    // Pattern angle gathered at each welded vertex, summed over its UV corners.
+    std::vector<double> angle(m.V.rows(), 0.0);
+    for (int f = 0; f < m.FUV.rows(); ++f)
+      for (int i = 0; i < 3; ++i) {
+        const Vec2 a = m.UV.row(m.FUV(f, i)), b = m.UV.row(m.FUV(f, (i + 1) % 3)), c = m.UV.row(m.FUV(f, (i + 2) % 3));
+        angle[m.F(f, i)] += std::acos(std::clamp((b - a).normalized().dot((c - a).normalized()), -1.0, 1.0));
+      }
+    const int worst = static_cast<int>(std::max_element(angle.begin(), angle.end()) - angle.begin());
+    const double degrees = angle[worst] * 180 / 3.14159265358979323846;
+    const Vec3 x = Vec3(m.V.row(worst)) - lm.axis;
+    MESSAGE("most pattern angle at one vertex: " << degrees << " degrees, at (" << x.transpose() << ") m");
+    CHECK(degrees < 460);
+    CHECK(degrees > 400);  // still a saddle: a pair of trousers cannot be flat at the crotch
+    // It is on the crotch seam: between the legs, below the body's crotch.
+    CHECK(std::abs(x.z()) < 0.03);
+    CHECK(std::abs(x.x()) < 0.05);
+    CHECK(x.y() < lm.crotch_y - 0.03);
   }
 }
 
