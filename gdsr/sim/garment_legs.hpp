@@ -53,14 +53,15 @@ inline LegCoords leg_coords(int panel, const gdsr::Vec2& uv, double W, double R,
   return lc;
 }
 
+// Segments of the crotch arc's polygon (45 degrees each: 4 edges of 2.4 cm at c = 3 cm).
+inline constexpr int kCrotchArcEdges = 4;
+
 // The two panels `prefix`_front and `prefix`_back (laid W + 0.1 apart, as leg_coords
 // expects): width W, height Htot, crotch Hc above the hem, notch half-width g at the hem,
 // ending in a point (c = 0) or a half-circle of radius c up to (0, Hc); side seams, inseams
 // and, for c > 0, the crotch seam. Edges: hem, inseam, [crotch arc: kCrotchArcEdges,] inseam,
 // hem, side up, top from +x to -x split into n_top equal edges (to sew another panel on),
 // side down. Returns the first top edge.
-inline constexpr int kCrotchArcEdges = 4;
-
 inline int add_two_leg_panels(Pattern& p, double W, double Htot, double Hc, double g, const std::string& prefix,
                               int n_top = 1, double c = 0) {
   constexpr double kPi = 3.14159265358979323846;

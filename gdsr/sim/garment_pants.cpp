@@ -48,7 +48,7 @@ GarmentDesign design_pants(const BodyLandmarks& lm) {
   const double ease = 0.015 * s;
   const double a = waist_perimeter(lm, ease) / (2 * kPi);
   const Cone yoke(a, std::max(R, a + 0.01 * s), Htot - Ht);
-  // Leg panels up to the hip line, whose edge is split like the yoke's lower arc (edges 5 .. 4 + n).
+  // Leg panels up to the hip line, whose edge is split like the yoke's lower arc (n edges from top_edge).
   const int n = std::max(8, static_cast<int>(std::ceil(kPi * yoke.b / 0.03)));
   const int top_edge = add_two_leg_panels(p, W, Ht, Hc, g, "pants", n, c);
   // The yoke (panels 2, 3): its lower arc's edge j (psi increasing) meets hip-line edge n - 1 - j.

@@ -150,14 +150,12 @@ TEST_CASE("garments: the paper's five garments rest outside the body, unstrained
       // No two triangles intersect (CGAL); -1 would mean a non-manifold or misoriented mesh.
       CHECK(self_intersections(m.V, m.F) == 0);
       // Rest strain against the flat pattern: developable pieces are isometric; the t-shirt's
-      // shoulder fold shears (E_uv) and the pants' crotch blend stretches (E_v) locally (E_v
-      // 0.11 / 0.14 at 30 / 10 mm since the crotch arc, whose cloth is placed on 0.64x its
-      // width between the legs, 0.12 and less before), and the
-      // pleated skirt's waistband, drawn in to the waist section, is gathered (E_v, E_uv
-      // 0.015-0.021), and so is the dress's bodice, a frustum from the round waist seam to the
-      // band fitted to the trunk (E_v, E_uv 0.018-0.020; the settle eases it). The cone skirts follow the waist section
-      // along its length (isometric at the waist; the blend below it strains the tiered skirt to E_u 0.002, E_uv
-      // 0.004).
+      // shoulder fold shears (E_uv) and the pants' crotch blend stretches (E_v) locally (0.10 /
+      // 0.14 at 30 / 10 mm; below 0.12 before the crotch arc, whose cloth is placed on 0.64x its
+      // width between the legs), and the pleated skirt's waistband, drawn in to the waist section, is gathered (E_v,
+      // E_uv 0.015-0.021), and so is the dress's bodice, a frustum from the round waist seam to the band fitted to the
+      // trunk (E_v, E_uv 0.018-0.020; the settle eases it). The cone skirts follow the waist section along its length
+      // (isometric at the waist; the blend below it strains the tiered skirt to E_u 0.002, E_uv 0.004).
       const auto se = gdsr::strain_energies(m, m.V);
       CAPTURE(se.E_u);
       CAPTURE(se.E_v);
