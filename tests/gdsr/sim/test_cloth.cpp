@@ -494,7 +494,7 @@ TEST_CASE("cloth: a garment without pins is carried by the arms it is worn on") 
   // 29 frames a few vertices stay up to 18 mm inside a forearm that pressed into the shirt
   // across the body: at most 4 of 1,799 in a frame (the test allows 1%), not a sleeve the arm
   // went through. Revision 19's closer-fitting shirt: 22 frames, at most 10 of 1,523 vertices, 28 mm
-  // deep.
+  // deep; revision 26's, centred on the trunk: 19 frames, at most 9 of 1,493, 29 mm.
   const GarmentRun run = tshirt_on_salsa("61_02");
   const auto& body = run.body;
   const auto& out = run.frames;
@@ -518,15 +518,15 @@ TEST_CASE("cloth: a garment without pins is carried by the arms it is worn on") 
 }
 
 namespace {
-// Frames of the 30 mm t-shirt on CMU 131_01 from 2 s for 1 s (46 frames with the rest blend) with
+// Frames of the 30 mm t-shirt on CMU 131_03 from 3 s for 1 s (46 frames with the rest blend) with
 // an edge longer than twice its pattern length: cloth threaded on a forearm, stretched between
-// its two sides. The arms drop from the A-pose onto the hips from frame 10. (131_03 showed it
-// until revision 19 fitted the shirt closer to the trunk: 1 frame of 46 pushed out at once now,
-// 10 from 3 s; 131_01: 28.)
+// its two sides. The arms drop from the A-pose onto the hips from frame 10. (Until revision 26
+// centred the shirt on the trunk, 131_01 from 2 s showed it best: 28 frames pushed out at once,
+// 5 since; 131_03 from 3 s 20.)
 int tshirt_walk_torn_frames(double max_push_step) {
   sim::SimParams p;
   p.max_push_step = max_push_step;
-  const GarmentRun run = run_on_clip("tshirt", std::string(GDSR_SHARED_DIR) + "/motions/cmu-walk/131_01.bvh", 2, 1, p);
+  const GarmentRun run = run_on_clip("tshirt", std::string(GDSR_SHARED_DIR) + "/motions/cmu-walk/131_03.bvh", 3, 1, p);
   REQUIRE(run.frames.size() == 46);
   int torn = 0;
   for (const Points3& X : run.frames) torn += max_edge_stretch(run.garment, X) > 2;
@@ -544,7 +544,7 @@ TEST_CASE("cloth: a forearm dropping onto the hip does not thread the t-shirt") 
   CHECK(capped <= 2);
   const int at_once = tshirt_walk_torn_frames(1e9);  // the test can fail: revision 14's push
   MESSAGE("... pushed out at once: " << at_once << " of 46");
-  CHECK(at_once >= 20);
+  CHECK(at_once >= 10);
 }
 
 namespace {
