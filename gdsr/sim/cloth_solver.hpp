@@ -331,7 +331,32 @@ struct SimParams {
                                       // of the vertex's first-pose home (a joint's crease) 91 / 26 / 0.0034 (the
                                       // 30 mm run that follows it 26.5% free of self-intersections);
                                       // limbs_pass_through for cloth without pins 49 / 18 / 0.0014, but the shirt
-                                      // then passes through the trunk and falls off the body
+                                      // then passes through the trunk and falls off the body.
+                                      // Tried at revision 26 on the walker's sleeve, none kept (30 mm at both
+                                      // resolutions, CMU 131_02 from 2 s for 4 s, friction 0.3 / 0.30001 /
+                                      // 0.30002: LR frames with cloth > 5 mm inside the body outside pinches,
+                                      // 118 / 119 / 119 by default): held cloth carried by the part it was
+                                      // dressed on 110 / 119 / 114 (salsa 60_02: 20.6-100% of frames free of
+                                      // self-intersections, edges > 2x their pattern in 6-10 frames), carried
+                                      // along its surface only 118 / 17 / 119 (60_02 mean E_u 0.0018 ->
+                                      // 0.0022); contacts deeper than max_push kept with the part it was
+                                      // dressed on 119 / 119 / 119 (and held cloth carried along its surface
+                                      // 118 / 119 / 119), with any part 119 / 119 / 119; only the
+                                      // foreign part pushing held cloth 118 / 119 / 118; cloth deeper than
+                                      // max_push pushed out towards the surface of that part it last touched
+                                      // 117 / 119 / 118 (at once: 118 / 119 / 118, 23.5% of frames free of
+                                      // self-intersections in one twin); the same with the side taken only
+                                      // while the cloth was outside 118 / 119 / 119 (at once 117 / 119 / 119,
+                                      // 19.1 / 99.3 / 22.8% free of self-intersections). The body is the
+                                      // cause: its forearm goes 39-46 mm into the hip at the clip's first
+                                      // frames (14-16) and 20 mm at frame 28 (none after frame 36), deeper
+                                      // than held cloth has room for, and swallows three vertices of the
+                                      // sleeve's underside there; pushed towards the side they came from, one
+                                      // pass at a time, they stay 12-31 mm inside it to the end of the clip:
+                                      // each pass pushes one 5 mm out and the constraints solved before the
+                                      // next pass put it back (21 mm under the forearm's surface). Without
+                                      // self-contact (data make --no-self-collision) that vertex stays out of
+                                      // the forearm, but the shirt's side is swallowed instead: 118 frames
   double max_speed = 15;                         // m/s, velocity clamp (safety against fast body parts)
   int settle_frames = 30;      // frames simulated on the first body pose before frame 0 (velocities zeroed at the end)
   double settle_rest_blend = 0.5;  // fraction of settle_frames over which rest lengths go from the placement to the pattern
