@@ -67,6 +67,7 @@ struct MakeArgs {
          compression_exponent = NAN, self_slack = NAN;
   double self_slack_per_pd = NAN, untangle_step = NAN, max_push_step = NAN, pinch_separation = NAN;
   double contact_travel = NAN;
+  double arm_clearance = 0.01;  // metres, gdsr::BodyOptions::arm_clearance (0: the motion as in the file)
   double pin_yield_rate = NAN;
   double track_rate = NAN;  // 1/s: the HR simulation follows the LR one at the LR scale (sim/cloth_tracking.hpp)
   bool self_collision = true;
@@ -171,6 +172,7 @@ void run_make(const MakeArgs& a) {
   bo.start_seconds = a.start;
   bo.max_seconds = a.seconds;
   bo.rest_arm_drop_degrees = sim::rest_arm_drop_degrees(a.garment);
+  bo.arm_clearance = a.arm_clearance;
   const double t_body = now_seconds();
   const gdsr::BodySequence body = gdsr::load_body_sequence(a.motion, bo);
   std::printf("body: %s, %d frames at %g fps (%d rest blend), %ld vertices, %.1f s\n", a.motion.c_str(),
@@ -179,6 +181,12 @@ void run_make(const MakeArgs& a) {
   if (bo.rest_arm_drop_degrees >= 0)
     std::printf("body: rest pose with the upper arms %g degrees below level (the %s is cut for it)\n",
                 bo.rest_arm_drop_degrees, a.garment.c_str());
+  if (body.arm_turns.turned_frames() > 0)
+    std::printf(
+        "body: an arm came within %g mm of the trunk or legs in %d frames; turned out at the shoulder by "
+        "up to %.1f degrees (%d frames still inside after the largest turn)\n",
+        1e3 * bo.arm_clearance, body.arm_turns.turned_frames(), body.arm_turns.max_degrees(),
+        body.arm_turns.still_inside_frames);
   if (!body.torso_found)
     std::fprintf(stderr,
                  "warning: %s: no hips and shoulders found among the skeleton's joint names; the body is a "
@@ -260,6 +268,10 @@ void run_make(const MakeArgs& a) {
                   {"settle_rest_blend", params.settle_rest_blend},
                   {"hr_start", hr_start_name(a)},
                   {"rest_arm_drop_degrees", bo.rest_arm_drop_degrees},
+                  {"arm_clearance_m", bo.arm_clearance},
+                  {"arm_turned_frames", body.arm_turns.turned_frames()},
+                  {"arm_turn_max_degrees", body.arm_turns.max_degrees()},
+                  {"arm_still_inside_frames", body.arm_turns.still_inside_frames},
                   {"self_collision", params.self_collision},
                   {"limbs_pass_through", params.limbs_pass_through},
                   {"limbs_pass_until_clear", params.limbs_pass_until_clear},
@@ -337,6 +349,10 @@ bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why
     }
     if (!sp.contains("solver_revision") || sp["solver_revision"] != sim::kSolverRevision) {
       why = "built by an older solver";
+      return false;
+    }
+    if (!same(sp.value("arm_clearance_m", 0.0), a.arm_clearance)) {
+      why = "built with another arm clearance";
       return false;
     }
     if (sp.value("hr_start", "") != hr_start_name(a)) {
@@ -723,6 +739,12 @@ void add_data_command(CLI::App& app) {
   make->add_flag("--skip-built", mk->skip_built,
                  "keep --out if it already holds this clip (garment, motion, range, particle distances), built by "
                  "this solver revision and valid (a recipe always does this)");
+  make->add_option("--arm-clearance", mk->arm_clearance,
+                   "metres: an upper arm coming closer than this to the trunk or legs (mocap arms pass through "
+                   "the body) is turned out at the shoulder just enough, eased over 0.2 s; 0: the motion as in "
+                   "the file")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.1));
   make->add_option("--rest-blend", mk->rest_blend_frames, "frames blending from the rest pose")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));

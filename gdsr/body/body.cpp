@@ -2,6 +2,7 @@
 
 #include "gdsr/error.hpp"
 
+#include "gdsr/body/body_query.hpp"
 #include "gdsr/body/skeleton_body.hpp"
 
 #include <assimp/Importer.hpp>
@@ -10,9 +11,11 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <stdexcept>
 
@@ -450,31 +453,41 @@ void orient_outward(Faces& F, const Points3& V) {
   if (vol < 0) F.col(1).swap(F.col(2));
 }
 
-// Body frames: `blend` frames from the rest pose into the first motion pose (smoothstep),
-// then n_motion frames of the clip at opt.fps from opt.start_seconds.
-std::vector<Points3> animate(const Clip& c, const Skin& sk, const ToMetres& to_out, const std::vector<Trs>& rest_local,
-                             const std::vector<Trs>& first, int blend, int n_motion, const BodyOptions& opt,
-                             const std::string& path) {
+// Local transforms of every body frame: `blend` frames from the rest pose into the first
+// motion pose (smoothstep), then n_motion frames of the clip at opt.fps from opt.start_seconds.
+std::vector<std::vector<Trs>> frame_poses(const Clip& c, const std::vector<Trs>& rest_local,
+                                          const std::vector<Trs>& first, int blend, int n_motion,
+                                          const BodyOptions& opt) {
   const size_t nn = c.rig.node.size();
-  std::vector<Points3> frames(blend + n_motion);
-  // Frames are independent: parallel over frames (skinning one frame is too small to split).
-  int bad_frame = -1;
+  std::vector<std::vector<Trs>> poses(blend + n_motion);
 #pragma omp parallel for schedule(dynamic, 4)
   for (int f = 0; f < blend + n_motion; ++f) {
-    std::vector<Trs> L;
     if (f < blend) {
       const double a = smoothstep(static_cast<double>(f) / blend);
-      L = rest_local;
+      std::vector<Trs> L = rest_local;
       for (size_t i = 0; i < nn; ++i) {
         L[i].t = (1 - a) * rest_local[i].t + a * first[i].t;
         L[i].r = rest_local[i].r.slerp(a, first[i].r);
         L[i].s = (1 - a) * rest_local[i].s + a * first[i].s;
       }
+      poses[f] = std::move(L);
     } else {
       const int k = f - blend;
-      L = k == 0 ? first : pose_at(c, opt.start_seconds + k / opt.fps);
+      poses[f] = k == 0 ? first : pose_at(c, opt.start_seconds + k / opt.fps);
     }
-    frames[f] = to_out(sk.apply(c.rig.globals(L)));
+  }
+  return poses;
+}
+
+// The body surface of every pose, metres. Frames are independent: parallel over frames
+// (skinning one frame is too small to split).
+std::vector<Points3> skin_frames(const Rig& rig, const Skin& sk, const ToMetres& to_out,
+                                 const std::vector<std::vector<Trs>>& poses, const std::string& path) {
+  std::vector<Points3> frames(poses.size());
+  int bad_frame = -1;
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int f = 0; f < static_cast<int>(poses.size()); ++f) {
+    frames[f] = to_out(sk.apply(rig.globals(poses[f])));
     if (!frames[f].allFinite()) {
 #pragma omp critical
       bad_frame = f;
@@ -483,6 +496,171 @@ std::vector<Points3> animate(const Clip& c, const Skin& sk, const ToMetres& to_o
   if (bad_frame >= 0)
     gdsr::fail("load_body_sequence: " + path, "non-finite vertices at frame " + std::to_string(bad_frame));
   return frames;
+}
+
+// Arm clearance (BodyOptions::arm_clearance). An arm is told from the rest of the body by
+// skin: a vertex belongs to an arm when its heaviest influence is a node under that upper arm.
+// Only arm vertices farther than kArmPartSeparation from the rest of the body at the build pose
+// are checked (the upper arm joins the trunk at the shoulder).
+constexpr double kArmPartSeparation = 0.15;      // metres, as ValidityOptions::pinch_separation
+constexpr double kArmTurnStep = 2 * M_PI / 180;  // search step; then 3 bisections (0.25 degrees)
+
+struct ArmParts {
+  std::vector<int> rig_node;               // the two upper arms' nodes (none: not recognised)
+  std::vector<std::vector<int>> vertices;  // per arm: its vertices checked for clearance
+  Faces others;                            // faces with no corner on an arm: trunk, legs, head
+  std::vector<char> rim;                   // per face of `others`: a corner on its open rim (the shoulders)
+};
+
+bool under(const Rig& rig, int node, int ancestor) {
+  for (; node >= 0; node = rig.parent[node])
+    if (node == ancestor) return true;
+  return false;
+}
+
+// rest: the body at the pose it was built in, metres.
+ArmParts arm_parts(const Rig& rig, const Skin& sk, const Points3& rest, const std::string& path) {
+  ArmParts parts;
+  const SkeletonNodes sn = skeleton_nodes(rig, rig.globals(rig.rest), path);
+  const std::vector<int> starts = detail::upper_arm_starts(sn.nodes);
+  if (starts.size() != 2) return parts;
+  for (int a : starts) parts.rig_node.push_back(sn.to_rig[a]);
+  const Eigen::Index nv = sk.P.rows();
+  std::vector<int> arm_of(nv, -1);
+  for (Eigen::Index i = 0; i < nv; ++i) {
+    int heaviest = sk.start[i];
+    for (int k = sk.start[i] + 1; k < sk.start[i + 1]; ++k)
+      if (sk.weight[k] > sk.weight[heaviest]) heaviest = k;
+    for (int a = 0; a < 2; ++a)
+      if (under(rig, sk.mat_node[sk.mat[heaviest]], parts.rig_node[a])) arm_of[i] = a;
+  }
+  std::vector<Eigen::Vector3i> others;
+  for (Eigen::Index f = 0; f < sk.F.rows(); ++f)
+    if (arm_of[sk.F(f, 0)] < 0 && arm_of[sk.F(f, 1)] < 0 && arm_of[sk.F(f, 2)] < 0)
+      others.emplace_back(sk.F(f, 0), sk.F(f, 1), sk.F(f, 2));
+  if (others.empty()) return ArmParts{};
+  parts.others.resize(static_cast<Eigen::Index>(others.size()), 3);
+  for (size_t f = 0; f < others.size(); ++f) parts.others.row(static_cast<Eigen::Index>(f)) = others[f].transpose();
+  std::map<std::pair<int, int>, int> edge_uses;  // an edge used once lies on the rim
+  for (const Eigen::Vector3i& t : others)
+    for (int k = 0; k < 3; ++k) ++edge_uses[std::minmax(t[k], t[(k + 1) % 3])];
+  std::vector<char> on_rim(nv, 0);
+  for (const auto& [e, uses] : edge_uses)
+    if (uses == 1) on_rim[e.first] = on_rim[e.second] = 1;
+  for (const Eigen::Vector3i& t : others) parts.rim.push_back(on_rim[t[0]] || on_rim[t[1]] || on_rim[t[2]]);
+  const ClosestPoints cp = BodyQuery(TriMesh{rest, parts.others}).closest(rest, /*smooth_normals=*/false);
+  parts.vertices.resize(2);
+  for (Eigen::Index i = 0; i < nv; ++i)
+    if (arm_of[i] >= 0 && std::abs(cp.sdist(i)) > kArmPartSeparation)
+      parts.vertices[arm_of[i]].push_back(static_cast<int>(i));
+  return parts;
+}
+
+// Arm a's point deepest towards the rest of the body in one frame V (metres): its signed
+// distance from that surface (< 0 inside; +inf with nothing within 0.3 m), the point, and the
+// surface's outward normal there. Points closest to the rim where the arms were cut off are
+// left out: that surface is open, and the sign of a distance to its rim means nothing.
+struct ArmGap {
+  double gap = std::numeric_limits<double>::infinity();
+  Vec3 point = Vec3::Zero(), normal = Vec3::Zero();
+};
+
+ArmGap arm_gap(const Points3& V, const ArmParts& parts, int a) {
+  const std::vector<int>& vs = parts.vertices[a];
+  Points3 Q(static_cast<Eigen::Index>(vs.size()), 3);
+  for (size_t k = 0; k < vs.size(); ++k) Q.row(static_cast<Eigen::Index>(k)) = V.row(vs[k]);
+  const ClosestPoints cp = BodyQuery(TriMesh{V, parts.others}).closest(Q, /*smooth_normals=*/false, 0.3);
+  ArmGap g;
+  for (Eigen::Index k = 0; k < Q.rows(); ++k)
+    if (cp.face(k) >= 0 && !parts.rim[cp.face(k)] && cp.sdist(k) < g.gap) {
+      g.gap = cp.sdist(k);
+      g.point = Q.row(k).transpose();
+      g.normal = cp.normal.row(k).transpose();
+    }
+  return g;
+}
+
+// Turns upper arm `node` of the local transforms L by `angle` radians about `axis` (unit, in
+// the parent's frame) through its shoulder.
+void turn_arm(std::vector<Trs>& L, int node, const Vec3& axis, double angle) {
+  L[node].r = (Quat(Eigen::AngleAxisd(angle, axis)) * L[node].r).normalized();
+}
+
+struct ArmTurn {
+  double angle = 0;          // radians
+  Vec3 axis = Vec3::Zero();  // unit, in the upper arm's parent's frame
+};
+
+// The smallest turn of arm a about its shoulder in pose L that leaves opt.arm_clearance between
+// the arm and the rest of the body, at most opt.max_arm_turn_degrees; about the axis that moves
+// the arm's deepest point along the body's normal there. No turn when it is clear already.
+ArmTurn arm_turn(const Rig& rig, const Skin& sk, const ToMetres& to_out, const ArmParts& parts, int a,
+                 const std::vector<Trs>& L, const BodyOptions& opt) {
+  auto gap = [&](const std::vector<Trs>& pose) { return arm_gap(to_out(sk.apply(rig.globals(pose))), parts, a); };
+  const ArmGap g = gap(L);
+  if (g.gap >= opt.arm_clearance) return {};
+  const int r = parts.rig_node[a];
+  const std::vector<Mat4> G = rig.globals(L);
+  const Vec3 w = (g.point - to_out(Vec3(G[r].topRightCorner<3, 1>()))).cross(g.normal);
+  if (w.norm() < 1e-9) return {};
+  const Eigen::Matrix3d Rp = (rig.parent[r] >= 0 ? G[rig.parent[r]] : rig.pre).topLeftCorner<3, 3>();
+  ArmTurn turn{0, (Rp.inverse() * w).normalized()};
+  auto clear_at = [&](double angle) {
+    std::vector<Trs> turned = L;
+    turn_arm(turned, r, turn.axis, angle);
+    return gap(turned).gap >= opt.arm_clearance;
+  };
+  const double max_angle = opt.max_arm_turn_degrees * M_PI / 180;
+  double lo = 0, hi = -1;  // not clear at lo, clear at hi
+  for (double t = kArmTurnStep; t < max_angle + kArmTurnStep && hi < 0; t += kArmTurnStep)
+    (clear_at(std::min(t, max_angle)) ? hi : lo) = std::min(t, max_angle);
+  if (hi < 0)
+    hi = max_angle;
+  else
+    for (int k = 0; k < 3; ++k) {
+      const double m = 0.5 * (lo + hi);
+      (clear_at(m) ? hi : lo) = m;
+    }
+  turn.angle = hi;
+  return turn;
+}
+
+// Turns the arms of every pose but the first (where garments are put on) that need it (see
+// arm_turn), eased in and out: frame f gets the largest of the turns of frames g weighted by
+// 1 - |f - g| / ease, so the turn changes by at most its size / ease per frame.
+ArmTurns clear_arms(const Rig& rig, const Skin& sk, const ToMetres& to_out, const ArmParts& parts,
+                    const BodyOptions& opt, std::vector<std::vector<Trs>>& poses) {
+  const int T = static_cast<int>(poses.size());
+  ArmTurns out;
+  out.degrees.assign(T, 0.0);
+  if (parts.rig_node.empty()) return out;
+  std::vector<std::array<ArmTurn, 2>> need(T);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int f = 1; f < T; ++f)
+    for (int a = 0; a < 2; ++a) need[f][a] = arm_turn(rig, sk, to_out, parts, a, poses[f], opt);
+  const int ease = std::max(1, static_cast<int>(std::lround(opt.arm_turn_ease_seconds * opt.fps)));
+  std::vector<char> turned(T, 0);
+  for (int f = 1; f < T; ++f)
+    for (int a = 0; a < 2; ++a) {
+      ArmTurn eased;
+      for (int g = std::max(1, f - ease + 1); g < std::min(T, f + ease); ++g) {
+        const double angle = need[g][a].angle * (1 - std::abs(f - g) / static_cast<double>(ease));
+        if (angle > eased.angle) eased = {angle, need[g][a].axis};
+      }
+      if (eased.angle <= 0) continue;
+      turn_arm(poses[f], parts.rig_node[a], eased.axis, eased.angle);
+      out.degrees[f] = std::max(out.degrees[f], eased.angle * 180 / M_PI);
+      turned[f] = 1;
+    }
+  std::vector<char> inside(T, 0);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int f = 1; f < T; ++f)
+    if (turned[f]) {
+      const Points3 V = to_out(sk.apply(rig.globals(poses[f])));
+      inside[f] = arm_gap(V, parts, 0).gap < 0 || arm_gap(V, parts, 1).gap < 0;
+    }
+  out.still_inside_frames = static_cast<int>(std::count(inside.begin(), inside.end(), 1));
+  return out;
 }
 
 // Landmarks of the rest pose: hip, waist and chest sections, shoulder and crotch heights.
@@ -529,10 +707,12 @@ BodyLandmarks measure_landmarks(const TriMesh& rest, const Surface& surf, const 
 
 BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_only) {
   if (!(opt.fps > 0) || !(opt.height > 0) || opt.rest_blend_frames < 0 || !(opt.start_seconds >= 0) ||
-      !(opt.body_edge > 0) || !(opt.rest_arm_drop_degrees <= 80))
+      !(opt.body_edge > 0) || !(opt.rest_arm_drop_degrees <= 80) || !(opt.arm_clearance >= 0) ||
+      !(opt.max_arm_turn_degrees > 0 && opt.max_arm_turn_degrees <= 90) || !(opt.arm_turn_ease_seconds >= 0))
     gdsr::fail("load_body_sequence: " + path,
                "bad BodyOptions (fps, height, body_edge must be > 0, rest_blend_frames and start_seconds >= 0, "
-               "rest_arm_drop_degrees <= 80)");
+               "rest_arm_drop_degrees <= 80, arm_clearance >= 0, max_arm_turn_degrees in (0, 90], "
+               "arm_turn_ease_seconds >= 0)");
   if (!std::ifstream(path).good()) gdsr::fail("load_body_sequence: " + path, "file not found or not readable");
   Assimp::Importer imp;
   const aiScene* s =
@@ -575,8 +755,14 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
                     [](const Vec3&) { return true; });
   seq.rest_V = opt.rest_arm_drop_degrees >= 0 ? to_out(surf.sk.apply(clip.rig.globals(start_local))) : to_out(rest_raw);
   seq.rest_blend_frames = rest_only ? 0 : opt.rest_blend_frames;
-  if (!rest_only)
-    seq.frames = animate(clip, surf.sk, to_out, start_local, first, opt.rest_blend_frames, n_motion, opt, path);
+  if (!rest_only) {
+    std::vector<std::vector<Trs>> poses = frame_poses(clip, start_local, first, opt.rest_blend_frames, n_motion, opt);
+    if (opt.arm_clearance > 0) {
+      const ArmParts parts = arm_parts(clip.rig, surf.sk, to_out(rest_raw), path);
+      seq.arm_turns = clear_arms(clip.rig, surf.sk, to_out, parts, opt, poses);
+    }
+    seq.frames = skin_frames(clip.rig, surf.sk, to_out, poses, path);
+  }
   seq.landmarks = measure_landmarks(TriMesh{seq.rest_V, seq.F}, surf, to_out, clip.skinned, opt.height);
   return seq;
 }

@@ -51,6 +51,31 @@ struct BodyOptions {
   // and its placement come from the file's rest pose either way: only frame 0 and the rest
   // blend from it change; every motion frame after the blend is the same.
   double rest_arm_drop_degrees = -1;
+  // Motion capture of a slim actor on a rounder body lets an arm pass through the trunk or the
+  // legs (a forearm swinging past the hip). > 0: in every frame after the first, an upper arm
+  // that comes closer than this many metres to the rest of the body is turned about its
+  // shoulder, away from the body, by the smallest angle that clears it (at most
+  // max_arm_turn_degrees), eased in and out over arm_turn_ease_seconds. 0: the motion as in
+  // the file. Bodies without two recognisable upper arms are left as they are.
+  double arm_clearance = 0;
+  double max_arm_turn_degrees = 30;
+  double arm_turn_ease_seconds = 0.2;
+};
+
+// How BodyOptions::arm_clearance changed the motion.
+struct ArmTurns {
+  std::vector<double> degrees;  // per frame, the larger of the two arms' turns (0: as in the file)
+  int still_inside_frames = 0;  // turned frames where an arm still enters the body (the turn capped)
+  int turned_frames() const {
+    int n = 0;
+    for (double d : degrees) n += d > 0;
+    return n;
+  }
+  double max_degrees() const {
+    double m = 0;
+    for (double d : degrees) m = d > m ? d : m;
+    return m;
+  }
 };
 
 // A horizontal cross-section of the rest-pose body (torso only: points within 0.35 m of
@@ -87,6 +112,7 @@ struct BodySequence {
   // Skeleton bodies: hips and shoulders recognised by joint name (false: a shoulderless column
   // of capsules; `gdsr data make` warns). Always true for skinned meshes.
   bool torso_found = true;
+  ArmTurns arm_turns;  // empty degrees unless BodyOptions::arm_clearance > 0
 
   int num_frames() const { return static_cast<int>(frames.size()); }
   TriMesh frame_mesh(int t) const;  // throws on t out of range

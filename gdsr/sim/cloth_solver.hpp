@@ -356,7 +356,10 @@ struct SimParams {
                                       // each pass pushes one 5 mm out and the constraints solved before the
                                       // next pass put it back (21 mm under the forearm's surface). Without
                                       // self-contact (data make --no-self-collision) that vertex stays out of
-                                      // the forearm, but the shirt's side is swallowed instead: 118 frames
+                                      // the forearm, but the shirt's side is swallowed instead: 118 frames.
+                                      // So the body is fixed instead (data make --arm-clearance, default 10 mm,
+                                      // gdsr::BodyOptions::arm_clearance): the arm is turned out at the shoulder
+                                      // by up to 7.5 degrees there, and the LR frames > 5 mm inside fall to 23
   double max_speed = 15;                         // m/s, velocity clamp (safety against fast body parts)
   int settle_frames = 30;      // frames simulated on the first body pose before frame 0 (velocities zeroed at the end)
   double settle_rest_blend = 0.5;  // fraction of settle_frames over which rest lengths go from the placement to the pattern

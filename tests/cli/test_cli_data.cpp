@@ -199,6 +199,13 @@ TEST_CASE("cli data: --skip-built keeps a clip built by this solver revision and
   REQUIRE(independent.status == 0);
   CHECK(independent.out.find("built with another HR start") != std::string::npos);
   CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"hr_start\": \"placement\"") != std::string::npos);
+  // So is the arm clearance the motion was fixed up with.
+  CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"arm_clearance_m\": 0.01") != std::string::npos);
+  const Run as_file = gdsr_run(dir, cmd + " --start 0.1 --independent-hr --arm-clearance 0");
+  REQUIRE(as_file.status == 0);
+  CHECK(as_file.out.find("built with another arm clearance") != std::string::npos);
+  CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"arm_clearance_m\": 0.0") != std::string::npos);
+  CHECK(gdsr_run(dir, cmd + " --arm-clearance -1").status != 0);
 }
 
 TEST_CASE("cli data: compare finds a repeat bit-identical, a nudged twin apart, and refuses other meshes") {

@@ -1,10 +1,12 @@
 #include "gdsr/body/body.hpp"
+#include "gdsr/geometry/self_intersections.hpp"
 #include "gdsr/sim/body_landmarks.hpp"
 #include "tests/support/data_fixtures.hpp"
 
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <string>
@@ -184,6 +186,75 @@ TEST_CASE("body: an A-pose rest turns the upper arms and leaves the body and the
   bad.rest_arm_drop_degrees = std::nan("");
   CHECK_THROWS_WITH_AS(load_body_sequence(kBvhTest, bad), doctest::Contains("rest_arm_drop_degrees"),
                        std::runtime_error);
+}
+
+// Frames where an arm crosses the rest of the body: two body faces intersect (CGAL) whose
+// corners were all more than 0.15 m apart in the first frame (a T-pose), not both on one arm
+// (more than 0.3 m out to the same side then: an elbow folding onto itself).
+static int arm_crossing_frames(const BodySequence& s) {
+  const Points3& rest = s.frames[0];
+  auto side = [&](int face) {
+    const double x = rest(s.F(face, 0), 0);
+    return x > 0.3 ? 1 : x < -0.3 ? -1 : 0;
+  };
+  int n = 0;
+  for (int f = 0; f < s.num_frames(); ++f) {
+    bool crossing = false;
+    for (const auto& [g, h] : self_intersections(s.frames[f], s.F, /*list_pairs=*/true).list) {
+      double closest = 1e9;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) closest = std::min(closest, (rest.row(s.F(g, i)) - rest.row(s.F(h, j))).norm());
+      crossing = crossing || (closest > 0.15 && (side(g) == 0 || side(g) != side(h)));
+    }
+    n += crossing;
+  }
+  return n;
+}
+
+TEST_CASE("body: an arm that passes through the hip in the motion is turned out just enough") {
+  // CMU 131_02 from 2 s: the walker's forearm swings up to 46 mm into the hip of our rounder
+  // capsule body in the clip's first frames (after the 15-frame rest blend).
+  const std::string walk = std::string(GDSR_SHARED_DIR) + "/motions/cmu-walk/131_02.bvh";
+  BodyOptions as_file, cleared;
+  as_file.start_seconds = cleared.start_seconds = 2;
+  as_file.max_seconds = cleared.max_seconds = 1;
+  cleared.arm_clearance = 0.01;
+  const BodySequence a = load_body_sequence(walk, as_file), b = load_body_sequence(walk, cleared);
+  CHECK(a.arm_turns.degrees.empty());
+  REQUIRE(static_cast<int>(b.arm_turns.degrees.size()) == b.num_frames());
+  const int before = arm_crossing_frames(a), after = arm_crossing_frames(b);
+  MESSAGE("frames with an arm crossing the body: " << before << " as in the file, " << after << " turned; "
+                                                   << b.arm_turns.turned_frames() << " frames turned, up to "
+                                                   << b.arm_turns.max_degrees() << " degrees");
+  CHECK(before >= 3);
+  CHECK(after == 0);
+  CHECK(b.arm_turns.still_inside_frames == 0);
+  // A few degrees, eased: the turn changes by at most its largest size / 6 frames (0.2 s at 30 fps).
+  CHECK(b.arm_turns.max_degrees() > 1);
+  CHECK(b.arm_turns.max_degrees() < 20);
+  for (int f = 1; f < b.num_frames(); ++f)
+    CHECK(std::abs(b.arm_turns.degrees[f] - b.arm_turns.degrees[f - 1]) <= b.arm_turns.max_degrees() / 6 + 1e-9);
+  // Frames without a turn are the file's motion to the bit; turned frames move the arms only
+  // (the legs, below the hands' reach, stay put).
+  CHECK(b.frames[0] == b.rest_V);
+  for (int f = 0; f < b.num_frames(); ++f) {
+    CAPTURE(f);
+    if (b.arm_turns.degrees[f] == 0) {
+      CHECK(a.frames[f] == b.frames[f]);
+      continue;
+    }
+    int moved = 0, moved_low = 0;
+    for (Eigen::Index v = 0; v < a.frames[f].rows(); ++v) {
+      const bool m = (a.frames[f].row(v) - b.frames[f].row(v)).norm() > 1e-6;
+      moved += m;
+      moved_low += m && a.frames[f](v, 1) < 0.5;
+    }
+    CHECK(moved > 50);
+    CHECK(moved_low == 0);
+  }
+  BodyOptions bad;
+  bad.arm_clearance = -0.01;
+  CHECK_THROWS_WITH_AS(load_body_sequence(walk, bad), doctest::Contains("arm_clearance"), std::runtime_error);
 }
 
 TEST_CASE("body: a skeleton whose hips are not recognised says so") {
