@@ -4,6 +4,7 @@
 
 #include "gdsr/body/body_query.hpp"
 #include "gdsr/body/skeleton_body.hpp"
+#include "gdsr/geometry/mesh_ops.hpp"
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -541,12 +542,8 @@ ArmParts arm_parts(const Rig& rig, const Skin& sk, const Points3& rest, const st
   if (others.empty()) return ArmParts{};
   parts.others.resize(static_cast<Eigen::Index>(others.size()), 3);
   for (size_t f = 0; f < others.size(); ++f) parts.others.row(static_cast<Eigen::Index>(f)) = others[f].transpose();
-  std::map<std::pair<int, int>, int> edge_uses;  // an edge used once lies on the rim
-  for (const Eigen::Vector3i& t : others)
-    for (int k = 0; k < 3; ++k) ++edge_uses[std::minmax(t[k], t[(k + 1) % 3])];
   std::vector<char> on_rim(nv, 0);
-  for (const auto& [e, uses] : edge_uses)
-    if (uses == 1) on_rim[e.first] = on_rim[e.second] = 1;
+  for (int v : boundary_vertices(parts.others)) on_rim[v] = 1;
   for (const Eigen::Vector3i& t : others) parts.rim.push_back(on_rim[t[0]] || on_rim[t[1]] || on_rim[t[2]]);
   const ClosestPoints cp = BodyQuery(TriMesh{rest, parts.others}).closest(rest, /*smooth_normals=*/false);
   parts.vertices.resize(2);
