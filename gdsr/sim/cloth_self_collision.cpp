@@ -149,6 +149,12 @@ struct SelfCollision::Embree {
   const Points3* x = nullptr;
   const Points3* motion = nullptr;  // null: boxes of the current positions only
   double pad = 0;
+  // The boxes are taken in a frame that moves along with the cloth: a path x + a motion is
+  // boxed as x - frame_start + a (motion - frame_motion), a in [0, 1]. The same shift for every
+  // primitive leaves each pair's relative motion as it was, so the test stays conservative,
+  // but the boxes of cloth carried along by a limb or the turning body stay short.
+  Vec3 frame_start = Vec3::Zero(), frame_motion = Vec3::Zero();
+  Vec3 detect_frame_motion = Vec3::Zero();  // frame_motion of the last detect (redetect continues it)
   const SelfCollision* owner = nullptr;
   // Per kind (vertices, edges, faces): each primitive's box in the last scene built of it,
   // written by the bounds callbacks, beside its vertex ids (one, two or three; -1 for none), so
@@ -176,7 +182,8 @@ struct SelfCollision::Embree {
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
     for (int k = 0; k < n; ++k)
       for (int c = 0; c < 3; ++c) {
-        const double a = (*x)(ids[k], c), b = motion ? a + (*motion)(ids[k], c) : a;
+        const double a = (*x)(ids[k], c) - frame_start[c];
+        const double b = motion ? a + (*motion)(ids[k], c) - frame_motion[c] : a;
         lo[c] = std::min(lo[c], std::min(a, b) - pad);
         hi[c] = std::max(hi[c], std::max(a, b) + pad);
       }
@@ -407,6 +414,8 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     // so that the edge and face boxes left in E.prims are the swept ones redetect relies on.
     E.motion = nullptr;
     E.pad = 0;
+    E.frame_start.setZero();
+    E.frame_motion.setZero();
     ScenesGuard g;
     g.s[1] = E.scene(ne, all_edges);
     g.s[2] = E.scene(nf, faces);
@@ -417,9 +426,12 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
       tangled_[edges_[e][0]] = tangled_[edges_[e][1]] = 1;
       for (int i = 0; i < 3; ++i) tangled_[F_(f, i)] = 1;
     }
-    E.motion = &motion;
-    E.pad = 0.5 * thickness + slack;
   }
+  E.motion = &motion;
+  E.pad = 0.5 * thickness + slack;
+  E.frame_start.setZero();
+  E.frame_motion = motion.rows() > 0 ? Vec3(motion.colwise().mean().transpose()) : Vec3::Zero();
+  E.detect_frame_motion = E.frame_motion;
   {
     // Vertex-face and edge-edge pairs on two threads (Embree's device runs one thread per
     // call), as jobs taken in turn: the vertex-face pairs, then every pair of edge chunks
@@ -460,12 +472,13 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
 }
 
 void SelfCollision::redetect(const Points3& x, const Points3& start, const Points3& motion,
-                             const std::vector<char>& moved, double slack, double thickness) {
+                             const std::vector<char>& moved, double elapsed, double slack, double thickness) {
   const int nf = static_cast<int>(F_.rows()), nv = static_cast<int>(x.rows()), ne = static_cast<int>(edges_.size());
   if (start.rows() != nv || motion.rows() != nv || static_cast<int>(moved.size()) != nv ||
       static_cast<int>(tangled_.size()) != nv)
     fail("positions, paths or moved flags do not match the vertex count");
   if (!(slack >= 0) || !(thickness > 0)) fail("slack must be >= 0 and thickness > 0");
+  if (!(elapsed >= 0 && elapsed <= 1)) fail("elapsed must be in [0, 1]");
   if (nf < 2) return;
   auto& E = *embree_;
   if (!E.kept[0]) fail("redetect needs a detect first");
@@ -487,6 +500,8 @@ void SelfCollision::redetect(const Points3& x, const Points3& start, const Point
   E.x = &start;
   E.motion = &motion;
   E.pad = 0.5 * thickness + slack;
+  E.frame_start = elapsed * E.detect_frame_motion;
+  E.frame_motion = (1 - elapsed) * E.detect_frame_motion;
   E.owner = this;
   const Embree::PrimList lists[3] = {{&E, 0, 0, ids[0].data()}, {&E, 1, 0, ids[1].data()}, {&E, 2, 0, ids[2].data()}};
   ScenesGuard g;  // s[k]: the moved primitives of kind k

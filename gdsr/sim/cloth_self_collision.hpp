@@ -2,8 +2,9 @@
 // constraints that keep non-adjacent parts of the cloth at least `thickness` metres apart.
 //
 // Broad phase: Embree's rtcCollide (vertices against faces, edges against edges and against
-// faces for the tangle test) on boxes swept along each vertex's
-// predicted motion until the next detection and grown by a slack, so every pair that can
+// faces for the tangle test) on boxes swept along each vertex's predicted motion until the
+// next detection, less the cloth's mean motion (a frame moving with the cloth: the same shift
+// for every vertex changes no pair's relative motion), and grown by a slack, so every pair that can
 // meet before the next detection is found (no tunnelling while each vertex stays within the
 // slack of its predicted path; as soon as one leaves it, the solver gives it a new path and
 // finds its pairs again, redetect, against the boxes the detection built for the rest). Narrow
@@ -57,22 +58,25 @@ class SelfCollision {
   // Finds every non-adjacent vertex-triangle and edge-edge pair that can come within
   // `thickness` metres while each vertex v stays within `slack` metres of its path
   // x.row(v) + a motion.row(v), a in [0, 1]; their sides are taken from x (assumed
-  // intersection-free except for tangled regions). tangle_test: also look for edges crossing
+  // intersection-free except for tangled regions). The paths are boxed in a frame that moves
+  // with the mean motion (only relative motion brings cloth together), so cloth carried
+  // along fast costs no more than cloth at rest. tangle_test: also look for edges crossing
   // triangles and refresh the tangled vertices (otherwise the last ones are kept).
   void detect(const gdsr::Points3& x, const gdsr::Points3& motion, double slack, double thickness,
               bool tangle_test = true);
 
   // After detect, when some vertices left their slack: moved[v] != 0 marks the vertices whose
-  // path changed since that detect. Every vertex v is now on the path start.row(v) + a
-  // motion.row(v), a in [0, 1], until the end of the detect's interval (for an unmoved vertex,
-  // the rest of the path it was detected on). The pairs of every vertex, edge and face with a
+  // path changed since that detect, `elapsed` in [0, 1] the part of the detect's interval gone
+  // by. Every vertex v is now on the path start.row(v) + a motion.row(v), a in [0, 1], until
+  // the end of the detect's interval (for an unmoved vertex, the rest of the path it was
+  // detected on). The pairs of every vertex, edge and face with a
   // moved vertex are found again by detect's rule on these paths, their sides taken from x (the
   // current positions, intersection-free); the other pairs are kept as they were. Only the moved
   // primitives' boxes are rebuilt, and collided with the scenes detect built (their boxes still
   // bound the unmoved primitives' paths), so this costs a fraction of a detect when few moved.
   // Tangled vertices are not refreshed.
   void redetect(const gdsr::Points3& x, const gdsr::Points3& start, const gdsr::Points3& motion,
-                const std::vector<char>& moved, double slack, double thickness);
+                const std::vector<char>& moved, double elapsed, double slack, double thickness);
 
   // One Gauss-Seidel pass over the pairs (fixed order): pushes pairs closer than
   // `thickness` apart along the triangle normal / edge-edge normal, by inverse masses winv
