@@ -61,7 +61,10 @@ class SelfCollision {
   // intersection-free except for tangled regions). The paths are boxed in a frame that moves
   // with the mean motion (only relative motion brings cloth together), so cloth carried
   // along fast costs no more than cloth at rest. tangle_test: also look for edges crossing
-  // triangles and refresh the tangled vertices (otherwise the last ones are kept).
+  // triangles and refresh the tangled vertices (otherwise the last ones are kept). The
+  // broad phase's trees are built anew at a detection with the tangle test (the solver's first
+  // of each frame) and refitted to the new boxes at the others (same tree, new boxes: the same
+  // pairs, as each pair's own boxes are tested).
   void detect(const gdsr::Points3& x, const gdsr::Points3& motion, double slack, double thickness,
               bool tangle_test = true);
 

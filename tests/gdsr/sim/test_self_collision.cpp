@@ -14,6 +14,7 @@
 #include "gdsr/sim/pattern.hpp"
 #include "gdsr/geometry/correspondence.hpp"
 #include "gdsr/geometry/self_intersections.hpp"
+#include "gdsr/error.hpp"
 #include "gdsr/geometry/triangle.hpp"
 
 #include <algorithm>
@@ -157,6 +158,19 @@ struct CrumpledSheets {
   }
 };
 
+// Paths for a redetect `half` through the interval: 5% of the vertices (drawn with `seed`) leave
+// their paths for new motions of up to 2 mm (moved, rest); the others go on along theirs.
+struct LeftPaths {
+  std::vector<char> moved;
+  Points3 rest;
+  LeftPaths(const Points3& motion, double half, unsigned seed) : moved(motion.rows(), 0), rest((1 - half) * motion) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (int v = 0; v < static_cast<int>(motion.rows()); ++v)
+      if (u(rng) > 0.9) moved[v] = 1, rest.row(v) = 0.002 * Eigen::RowVector3d(u(rng), u(rng), u(rng));
+  }
+};
+
 }  // namespace
 
 TEST_CASE("self-collision: detect keeps every pair within reach that a search over all pairs finds") {
@@ -250,12 +264,9 @@ TEST_CASE("self-collision: cloth carried along together finds the pairs it finds
   const int nv = static_cast<int>(m.V.rows());
   const double thickness = 0.005, slack = 0.001, half = 0.5;
   const Eigen::RowVector3d carried(0.03, -0.04, 0.0);
-  std::vector<char> moved(nv, 0);
-  Points3 new_rest = (1 - half) * sheets.motion;
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> u(-1, 1);
-  for (int v = 0; v < nv; ++v)
-    if (u(rng) > 0.9) moved[v] = 1, new_rest.row(v) = 0.002 * Eigen::RowVector3d(u(rng), u(rng), u(rng));
+  const LeftPaths left(sheets.motion, half, 3);
+  const std::vector<char>& moved = left.moved;
+  const Points3& new_rest = left.rest;
   std::vector<std::array<int, 2>> vt[2][2], ee[2][2];  // [carried?][before / after the redetect]
   for (int k = 0; k < 2; ++k) {
     Points3 motion = sheets.motion, rest = new_rest;
@@ -275,6 +286,61 @@ TEST_CASE("self-collision: cloth carried along together finds the pairs it finds
     CHECK(ee[1][i] == ee[0][i]);
   }
   CHECK(vt[0][1] != vt[0][0]);  // the redetect found other pairs for the moved vertices
+}
+
+TEST_CASE("self-collision: a detection that refits the last one's trees finds what a fresh detection finds") {
+  // One detector detects the crumpled sheets of seed 5 (trees built), then those of seed 6
+  // without the tangle test (trees refitted to the new boxes), then redetects 5% of the
+  // vertices against the refitted trees; a fresh detector does the same on seed 6 only. A
+  // refit that kept the old boxes would miss the pairs that only the new positions bring together.
+  const CrumpledSheets first(5), second(6);
+  const auto& m = first.m;
+  const int nv = static_cast<int>(m.V.rows());
+  const double thickness = 0.005, slack = 0.001, half = 0.5;
+  const LeftPaths left(second.motion, half, 4);
+  const std::vector<char>& moved = left.moved;
+  const Points3& rest = left.rest;
+  const Points3 start = second.x + half * second.motion;
+  sim::SelfCollision refitted(m.F, nv), fresh(m.F, nv);
+  refitted.detect(first.x, first.motion, slack, thickness, /*tangle_test=*/true);
+  const auto vt_first = refitted.vertex_triangle_pairs();
+  refitted.detect(second.x, second.motion, slack, thickness, /*tangle_test=*/false);
+  fresh.detect(second.x, second.motion, slack, thickness, /*tangle_test=*/false);
+  MESSAGE("vertex-triangle " << fresh.vertex_triangle_pairs().size() << ", edge-edge "
+                             << fresh.edge_edge_pairs().size());
+  CHECK(fresh.vertex_triangle_pairs().size() > 1000);
+  CHECK(fresh.vertex_triangle_pairs() != vt_first);  // the two states have different pairs
+  CHECK(refitted.vertex_triangle_pairs() == fresh.vertex_triangle_pairs());
+  CHECK(refitted.edge_edge_pairs() == fresh.edge_edge_pairs());
+  refitted.redetect(start, start, rest, moved, half, slack, thickness);
+  fresh.redetect(start, start, rest, moved, half, slack, thickness);
+  CHECK(refitted.num_redetections() == 1);
+  CHECK(refitted.vertex_triangle_pairs() == fresh.vertex_triangle_pairs());
+  CHECK(refitted.edge_edge_pairs() == fresh.edge_edge_pairs());
+}
+
+TEST_CASE("self-collision: bad inputs are refused with a message naming the problem") {
+  const CrumpledSheets sheets(5);
+  const auto& m = sheets.m;
+  const int nv = static_cast<int>(m.V.rows());
+  const Points3 &x = sheets.x, &motion = sheets.motion;
+  const std::vector<char> none(nv, 0);
+  using doctest::Contains;
+  CHECK_THROWS_WITH_AS(sim::SelfCollision(m.F, nv - 1), Contains("faces index missing vertices"), gdsr::Error);
+  sim::SelfCollision sc(m.F, nv);
+  CHECK_THROWS_WITH_AS(sc.redetect(x, x, motion, none, 0.5, 0.001, 0.005), Contains("needs a detect first"),
+                       gdsr::Error);
+  CHECK_THROWS_WITH_AS(sc.detect(x.topRows(nv - 1), motion.topRows(nv - 1), 0.001, 0.005),
+                       Contains("do not match the vertex count"), gdsr::Error);
+  CHECK_THROWS_WITH_AS(sc.detect(x, motion, -0.001, 0.005), Contains("slack must be >= 0"), gdsr::Error);
+  CHECK_THROWS_WITH_AS(sc.detect(x, motion, 0.001, std::nan("")), Contains("thickness > 0"), gdsr::Error);
+  sc.detect(x, motion, 0.001, 0.005);
+  for (const double elapsed : {-0.1, 1.5, std::nan("")})
+    CHECK_THROWS_WITH_AS(sc.redetect(x, x, motion, none, elapsed, 0.001, 0.005), Contains("elapsed must be in [0, 1]"),
+                         gdsr::Error);
+  CHECK_THROWS_WITH_AS(sc.redetect(x, x, motion, std::vector<char>(nv - 1, 0), 0.5, 0.001, 0.005),
+                       Contains("do not match the vertex count"), gdsr::Error);
+  CHECK(sc.num_detections() == 1);  // only the good detect counted
 }
 
 TEST_CASE("self-collision: redetect finds the moved vertices' pairs again and keeps the others") {
