@@ -165,8 +165,8 @@ struct SelfCollision::Embree {
   };
   mutable std::vector<Prim> prims[3];
   // The primitives a scene holds, of one kind (0 vertices, 1 edges, 2 faces): full ids
-  // first + primID, or ids[primID] if ids is set. Read only while the scene is committed (by
-  // prim_bounds), so a kept scene may outlive the list it was built from.
+  // first + primID, or ids[primID] if ids is set. Read by prim_bounds whenever the scene is
+  // committed (built or refitted): a kept scene reads its copy in kept_lists.
   struct PrimList {
     const Embree* e;
     int kind;
@@ -184,7 +184,8 @@ struct SelfCollision::Embree {
   PrimList kept_lists[2 + kEdgeChunks];   // what each kept scene holds (read again by a refit)
   // Kept scene k, of `count` primitives of `list`: its tree refitted to the primitives' new
   // boxes if it exists and `rebuild` is false (same pairs: the callback tests each pair's own
-  // boxes), else built anew.
+  // boxes), else built anew. A refit keeps the count: it is fixed by the faces, which a
+  // SelfCollision never changes.
   void keep_scene(int k, int count, const PrimList& list, bool rebuild) {
     RTCScene& sc = kept[k];
     kept_lists[k] = list;
