@@ -315,9 +315,9 @@ struct SelfCollision::Embree {
   }
   // Pairs kept by the last collide of each call site (slot): the next one reserves that
   // many, as growing the list was 2.5% of a simulation.
-  // Slots: vertex-face, the pairs of edge chunks, redetect's collides, the tangle test.
+  // Slots: vertex-face, the pairs of edge chunks, redetect's collides, the tangle test's two.
   static constexpr int kRedetectSlot = 1 + kEdgeChunks * (kEdgeChunks + 1) / 2;
-  static constexpr int kSlots = kRedetectSlot + 4 + kEdgeChunks + 1;
+  static constexpr int kSlots = kRedetectSlot + 4 + kEdgeChunks + 2;
   size_t last_count[kSlots] = {};
   // The narrow phase's survivors among the overlaps of scenes a (kind ka) and b (kind kb), in
   // callback order (the caller sorts them). Out: VT (vertices x faces), EE (edges x edges) or
@@ -425,7 +425,7 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
   for (int c = 0; c <= K; ++c) first[c] = static_cast<int>(static_cast<long long>(ne) * c / K);
   // The edges are collided with each other in K scenes of consecutive edges (chunks), so that
   // the pairs of chunks (and the vertex-face pairs) are jobs the two threads can share out.
-  const Embree::PrimList vertices{&E, 0}, all_edges{&E, 1}, faces{&E, 2};
+  const Embree::PrimList vertices{&E, 0}, faces{&E, 2};
   Embree::PrimList chunks[K];
   for (int c = 0; c < K; ++c) chunks[c] = {&E, 1, first[c]};
   // The narrow phase runs inside the collides' callbacks, each pair on its own, so what is
@@ -439,10 +439,19 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     E.pad = 0;
     E.frame_start.setZero();
     E.frame_motion.setZero();
-    ScenesGuard g;
-    g.s[1] = E.scene(ne, all_edges);
-    g.s[2] = E.scene(nf, faces);
-    crossings_ = E.collide<std::array<int, 2>>(g.s[1], 1, {}, g.s[2], 2, {}, Embree::kSlots - 1, narrow);
+    // Two halves of the edges against the faces, on two threads.
+    ScenesGuard g;  // s[0], s[1]: the halves of the edges; s[2]: the faces
+    const int half = ne / 2;
+    const Embree::PrimList halves[2] = {{&E, 1, 0}, {&E, 1, half}};
+    run_jobs(3, [&](int k) { g.s[k] = k < 2 ? E.scene(k ? ne - half : half, halves[k]) : E.scene(nf, faces); });
+    std::vector<std::array<int, 2>> parts[2];
+    run_jobs(2, [&](int k) {
+      if ((k ? ne - half : half) > 0)  // (Embree's collide crashed on an empty scene)
+        parts[k] =
+            E.collide<std::array<int, 2>>(g.s[k], 1, {k ? half : 0}, g.s[2], 2, {}, Embree::kSlots - 2 + k, narrow);
+    });
+    crossings_ = std::move(parts[0]);
+    crossings_.insert(crossings_.end(), parts[1].begin(), parts[1].end());
     std::sort(crossings_.begin(), crossings_.end());  // the broad phase's order is not fixed
     intersecting_ = static_cast<int>(crossings_.size());
     for (const auto& [e, f] : crossings_) {

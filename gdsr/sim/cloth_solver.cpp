@@ -3,6 +3,7 @@
 #include "gdsr/error.hpp"
 
 #include <Eigen/Geometry>
+#include <omp.h>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -141,6 +142,9 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
   std::vector<std::vector<int>> edges_at(static_cast<size_t>(m.V.rows()));
   for (int e = 0; e < static_cast<int>(edges_.size()); ++e) edges_at[edges_[e].i].push_back(e), edges_at[edges_[e].j].push_back(e);
   vertex_edges_ = gdsr::build_csr(std::move(edges_at));
+  std::vector<GaussSeidelSchedule::Item> edge_ends(edges_.size());
+  for (size_t e = 0; e < edges_.size(); ++e) edge_ends[e] = {edges_[e].i, edges_[e].j, -1, -1};
+  edge_schedule_.plan(edge_ends, nv);
 
   // Body grid for the rest pose; initial push-out; pins.
   const double cell = std::max(0.05, p.contact_radius + p.thickness);
@@ -548,35 +552,47 @@ void ClothSolver::predict(double h, double decay) {
   }
 }
 
-void ClothSolver::classify_edges() {
+void ClothSolver::prepare_stretch_pass(double h2) {
   // Once per substep, before the passes, each edge's compliance factor from its strain: 1 when
   // stretched, 1 / compression_ratio beyond 0.1% compression, a smoothstep between (a jump at
   // zero strain, or a switch between passes with lambda from the other regime, makes edges
-  // near their rest length chatter).
+  // near their rest length chatter). Stored with what the passes read of the edge, by its slot
+  // in edge_schedule_.
   const double eps0 = 1e-3;
-  edge_scale_.resize(edges_.size());
-  for (size_t c = 0; c < edges_.size(); ++c) {
-    const double strain = (x_.row(edges_[c].i) - x_.row(edges_[c].j)).norm() / edges_[c].rest - 1;
+  pass_edges_.resize(edges_.size());
+  const int ne = static_cast<int>(edges_.size());
+#pragma omp parallel for schedule(static) num_threads(2) if (ne > 4096 && omp_get_max_threads() > 1)
+  for (int c = 0; c < ne; ++c) {
+    const Edge& e = edges_[c];
+    const double strain = (x_.row(e.i) - x_.row(e.j)).norm() / e.rest - 1;
     const double t = std::clamp(1 + strain / eps0, 0.0, 1.0), s = t * t * (3 - 2 * t);
-    edge_scale_[c] = 1 / (p_.compression_ratio + (1 - p_.compression_ratio) * s);
+    const double scale = 1 / (p_.compression_ratio + (1 - p_.compression_ratio) * s);
+    pass_edges_[edge_schedule_.slot(c)] = {e.i, e.j, e.rest, scale * e.compliance / h2};
   }
 }
 
-void ClothSolver::solve_edges(std::vector<double>& lambda_e, double h2) {
-  for (size_t c = 0; c < edges_.size(); ++c) {
-    const Edge& e = edges_[c];
+void ClothSolver::solve_edges(std::vector<double>& lambda) {
+  // Each edge sees every earlier edge's moves, as in a pass in edge order; on two threads for a
+  // fine mesh with the same result (GaussSeidelSchedule). lambda: by slot.
+  auto solve = [&](int, int slot) {
+    const PassEdge& e = pass_edges_[slot];
     const double wi = winv_[e.i], wj = winv_[e.j];
-    if (wi + wj == 0) continue;
+    if (wi + wj == 0) return;
     Vec3 d = x_.row(e.i) - x_.row(e.j);
     const double len = d.norm();
-    if (len < 1e-12) continue;
+    if (len < 1e-12) return;
     d /= len;
-    const double at = edge_scale_[c] * e.compliance / h2;
-    const double dl = (-(len - e.rest) - at * lambda_e[c]) / (wi + wj + at);
-    lambda_e[c] += dl;
+    const double dl = (-(len - e.rest) - e.at * lambda[slot]) / (wi + wj + e.at);
+    lambda[slot] += dl;
     x_.row(e.i) += (wi * dl) * d.transpose();
     x_.row(e.j) -= (wj * dl) * d.transpose();
-  }
+  };
+  // Below ~10k edges the threads' start-up and waits cost more than they save.
+  constexpr int kScheduledEdges = 8192;
+  if (edge_schedule_.size() >= kScheduledEdges)
+    edge_schedule_.run(solve);
+  else
+    for (int c = 0; c < static_cast<int>(edges_.size()); ++c) solve(c, edge_schedule_.slot(c));
 }
 
 void ClothSolver::solve_bends(std::vector<double>& lambda_b, double h2) {
@@ -778,12 +794,12 @@ void ClothSolver::step(const Points3& body_from, const Points3& body_to, double 
     if (has_body) place_pins(body_now, h);
     if (implicit_bending_) implicit_bending_->solve(h, x_);
     std::fill(lambda_e.begin(), lambda_e.end(), 0.0);
-    classify_edges();
+    prepare_stretch_pass(h2);
     std::fill(lambda_b.begin(), lambda_b.end(), 0.0);
     if (self_ && p_.untangle_step > 0) self_->untangle(x_, winv_, p_.untangle_step * p_.self_thickness);
     for (int it = 0; it < p_.iterations; ++it) {
       for (int k = 0; k < p_.stretch_passes; ++k) {
-        solve_edges(lambda_e, h2);
+        solve_edges(lambda_e);
         project_tethers(tethers_, p_.tether_stretch, x_);
       }
       if (!implicit_bending_) solve_bends(lambda_b, h2);

@@ -27,6 +27,7 @@
 #include "gdsr/sim/cloth_self_collision.hpp"
 #include "gdsr/sim/cloth_tethers.hpp"
 #include "gdsr/sim/cloth_tracking.hpp"
+#include "gdsr/sim/gauss_seidel_schedule.hpp"
 #include "gdsr/sim/garments.hpp"
 
 #include <array>
@@ -519,8 +520,8 @@ class ClothSolver {
   bool redetect_self_contacts(double h);
   Eigen::RowVector3d predicted_motion(int v, int substeps, double h) const;  // m, of vertex v over the next substeps
   void predict(double h, double decay);
-  void classify_edges();
-  void solve_edges(std::vector<double>& lambda, double h2);
+  void prepare_stretch_pass(double h2);           // fills pass_edges_ for a substep of h = sqrt(h2) s
+  void solve_edges(std::vector<double>& lambda);  // one stretch pass; lambda by slot of edge_schedule_
   void solve_bends(std::vector<double>& lambda, double h2);
   void solve_layers();
   void solve_body_contacts(const gdsr::Points3& body_prev, const gdsr::Points3& body_now);
@@ -537,9 +538,17 @@ class ClothSolver {
   std::vector<double> mass_, winv_;
   std::vector<Edge> edges_;
   gdsr::Csr vertex_edges_;  // indices into edges_ of the edges at each vertex
+  GaussSeidelSchedule edge_schedule_;                         // solve_edges' pass over edges_ on two threads
   std::vector<double> edge_rest_placed_, edge_rest_pattern_;  // m, per edge
   std::vector<double> tether_rest_placed_, tether_rest_pattern_;  // m, per tether (placed: not below the pattern)
-  std::vector<double> edge_scale_;  // per edge, this substep: compliance factor (1 stretched, 1/compression_ratio)
+  // What a stretch pass reads of each edge, by its slot in edge_schedule_, this substep: its
+  // vertices, rest length (m) and compliance over h^2 (times 1 stretched, 1/compression_ratio
+  // compressed).
+  struct PassEdge {
+    int i, j;
+    double rest, at;
+  };
+  std::vector<PassEdge> pass_edges_;
   std::vector<Bend> bends_;
   PinBinding pins_;
   std::vector<int> pin_of_;   // per cloth vertex: its pin in pins_ (-1: none); only with pin_yield_rate > 0
