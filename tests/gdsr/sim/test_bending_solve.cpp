@@ -4,6 +4,8 @@
 // the solver's assembled matrix), and the fixed vertices left where they were.
 #include <doctest/doctest.h>
 
+#include "tests/support/two_omp_threads.hpp"
+
 #include "gdsr/sim/cloth_bending_solve.hpp"
 #include "gdsr/error.hpp"
 
@@ -68,18 +70,10 @@ void residual(const Sheet& s, double h, const Points3& x, double& rel, double& f
   }
 }
 
-// Two OpenMP threads for the test's scope: ctest runs with OMP_NUM_THREADS=1 (scripts/test.sh),
-// which the code under test honours.
-struct TwoThreads {
-  int before = omp_get_max_threads();
-  TwoThreads() { omp_set_num_threads(2); }
-  ~TwoThreads() { omp_set_num_threads(before); }
-};
-
 }  // namespace
 
 TEST_CASE("implicit bending: the solve satisfies M (x - y) + h^2 grad E(x) = 0, on one thread and on two") {
-  const TwoThreads threads;
+  const sim::TwoOmpThreads threads;
   // 10 x 10 runs on one thread; 70 x 70 (4,830 free vertices) on two (the solve shares the
   // x, y and z substitutions out from 4,096 free vertices).
   for (int n : {10, 70}) {
@@ -100,7 +94,7 @@ TEST_CASE("implicit bending: the solve satisfies M (x - y) + h^2 grad E(x) = 0, 
 }
 
 TEST_CASE("implicit bending: the two-thread solve gives the one-thread result bit for bit") {
-  const TwoThreads threads;
+  const sim::TwoOmpThreads threads;
   const Sheet s = make_sheet(70, 11);
   sim::ImplicitBending bending(70 * 70, s.bends, s.mass, s.fixed);
   Points3 two = s.y, one = s.y;

@@ -4,6 +4,8 @@
 // with a few long "seam" edges joining far-apart vertex numbers (as a garment's panels are).
 #include <doctest/doctest.h>
 
+#include "tests/support/two_omp_threads.hpp"
+
 #include "gdsr/sim/gauss_seidel_schedule.hpp"
 #include "gdsr/error.hpp"
 #include "gdsr/geometry/mesh.hpp"
@@ -71,18 +73,10 @@ Points3 sequential(const Sheet& s, int passes) {
   return x;
 }
 
-// Two OpenMP threads for the test's scope: ctest runs with OMP_NUM_THREADS=1 (scripts/test.sh),
-// which the code under test honours.
-struct TwoThreads {
-  int before = omp_get_max_threads();
-  TwoThreads() { omp_set_num_threads(2); }
-  ~TwoThreads() { omp_set_num_threads(before); }
-};
-
 }  // namespace
 
 TEST_CASE("gauss-seidel schedule: two threads give the sequential pass bit for bit, seams and all") {
-  const TwoThreads threads;
+  const sim::TwoOmpThreads threads;
   for (int seams : {0, 40, 400}) {
     CAPTURE(seams);
     const Sheet s = make_sheet(80, seams, 3 + seams);
@@ -110,7 +104,7 @@ TEST_CASE("gauss-seidel schedule: two threads give the sequential pass bit for b
 }
 
 TEST_CASE("gauss-seidel schedule: four-vertex items (contact pairs) give the sequential pass bit for bit") {
-  const TwoThreads threads;
+  const sim::TwoOmpThreads threads;
   // Vertex-triangle pairs as the self-contact projection has them: sorted by the vertex, each
   // against a triangle of three vertices near it; a step pulls the four a length-dependent way.
   const Sheet s = make_sheet(60, 0, 9);
@@ -142,7 +136,7 @@ TEST_CASE("gauss-seidel schedule: four-vertex items (contact pairs) give the seq
 }
 
 TEST_CASE("gauss-seidel schedule: on one thread (a nested region) it runs the items in order") {
-  const TwoThreads threads;
+  const sim::TwoOmpThreads threads;
   const Sheet s = make_sheet(30, 10, 5);
   sim::GaussSeidelSchedule schedule;
   schedule.plan(s.edges, s.nv);
@@ -167,7 +161,7 @@ TEST_CASE("gauss-seidel schedule: on one thread (a nested region) it runs the it
 
 TEST_CASE(
     "gauss-seidel schedule: a chain has one level per item, an empty list runs nothing, bad vertices are refused") {
-  const TwoThreads threads;
+  const sim::TwoOmpThreads threads;
   std::vector<sim::GaussSeidelSchedule::Item> chain;
   for (int v = 0; v + 1 < 50; ++v) chain.push_back({v, v + 1, -1, -1});
   sim::GaussSeidelSchedule schedule;
