@@ -10,25 +10,24 @@ namespace sim {
 void GaussSeidelSchedule::plan(const std::vector<Item>& items, int num_vertices) {
   count_ = static_cast<int>(items.size());
   // Levels, and each item's last earlier item on each of its vertices (its predecessors).
-  last_.assign(num_vertices, -1);
-  level_.resize(count_);
-  pred_.resize(count_);
+  std::vector<int> last(num_vertices, -1), level(count_);
+  std::vector<Item> pred(count_);
   levels_ = 0;
   for (int k = 0; k < count_; ++k) {
     int l = 0;
     for (int s = 0; s < 4; ++s) {
       const int v = items[k][s];
-      pred_[k][s] = -1;
+      pred[k][s] = -1;
       if (v < 0) continue;
       if (v >= num_vertices)
         gdsr::fail("sim/gauss_seidel_schedule", "item vertex " + std::to_string(v) + " out of range");
-      pred_[k][s] = last_[v];
-      if (last_[v] >= 0) l = std::max(l, level_[last_[v]]);
+      pred[k][s] = last[v];
+      if (last[v] >= 0) l = std::max(l, level[last[v]]);
     }
-    level_[k] = l + 1;
+    level[k] = l + 1;
     levels_ = std::max(levels_, l + 1);
     for (int v : items[k])
-      if (v >= 0) last_[v] = k;
+      if (v >= 0) last[v] = k;
   }
   // Thread by the item's smallest vertex: below the split vertex list 0, else list 1, the split
   // chosen so that the lists are about equally long.
@@ -38,20 +37,20 @@ void GaussSeidelSchedule::plan(const std::vector<Item>& items, int num_vertices)
       if (v >= 0) m = std::min(m, v);
     return m == num_vertices ? 0 : m;
   };
-  at_vertex_.assign(num_vertices + 1, 0);
-  for (int k = 0; k < count_; ++k) ++at_vertex_[key(k)];
+  std::vector<int> at_vertex(num_vertices + 1, 0);
+  for (int k = 0; k < count_; ++k) ++at_vertex[key(k)];
   int split = 0;
-  for (int below = 0; split < num_vertices && 2 * (below + at_vertex_[split]) <= count_; ++split)
-    below += at_vertex_[split];
+  for (int below = 0; split < num_vertices && 2 * (below + at_vertex[split]) <= count_; ++split)
+    below += at_vertex[split];
   // Each list in level order (counting sort; the sequential order within a level).
-  by_level_.assign(levels_ + 2, 0);
-  for (int k = 0; k < count_; ++k) ++by_level_[level_[k] + 1];
-  for (int l = 1; l < levels_ + 2; ++l) by_level_[l] += by_level_[l - 1];
-  order_.resize(count_);
-  for (int k = 0; k < count_; ++k) order_[by_level_[level_[k]]++] = k;
+  std::vector<int> by_level(levels_ + 2, 0);
+  for (int k = 0; k < count_; ++k) ++by_level[level[k] + 1];
+  for (int l = 1; l < levels_ + 2; ++l) by_level[l] += by_level[l - 1];
+  std::vector<int> order(count_);
+  for (int k = 0; k < count_; ++k) order[by_level[level[k]]++] = k;
   std::vector<Step> lists[2];
   std::vector<int> list_of(count_), pos(count_);
-  for (int k : order_) {
+  for (int k : order) {
     const int t = key(k) < split ? 0 : 1;
     list_of[k] = t;
     pos[k] = static_cast<int>(lists[t].size());
@@ -61,7 +60,7 @@ void GaussSeidelSchedule::plan(const std::vector<Item>& items, int num_vertices)
   // comes earlier in it: its level is lower).
   for (int t = 0; t < 2; ++t)
     for (Step& s : lists[t])
-      for (int q : pred_[s.item])
+      for (int q : pred[s.item])
         if (q >= 0 && list_of[q] != t) s.wait = std::max(s.wait, pos[q] + 1);
   first_[1] = static_cast<int>(lists[0].size());
   steps_ = std::move(lists[0]);

@@ -78,9 +78,6 @@ class GaussSeidelSchedule {
   std::vector<int> slot_of_;
   int first_[2] = {0, 0};
   int count_ = 0, levels_ = 0;
-  // plan's scratch
-  std::vector<int> last_, level_, at_vertex_, by_level_, order_;
-  std::vector<Item> pred_;
 };
 
 }  // namespace sim
