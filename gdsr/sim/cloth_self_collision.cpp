@@ -1,6 +1,9 @@
 #include "gdsr/sim/cloth_self_collision.hpp"
 
+#include "gdsr/sim/contact_geometry.hpp"
+
 #include "gdsr/error.hpp"
+#include "gdsr/geometry/mesh_ops.hpp"
 #include "gdsr/geometry/triangle.hpp"
 
 #include <embree3/rtcore.h>
@@ -24,68 +27,6 @@ using gdsr::Vec3;
 namespace {
 
 [[noreturn]] void fail(const std::string& msg) { gdsr::fail("sim/cloth_self_collision", msg); }
-
-// Closest points of segments p1q1 and p2q2 (Ericson, Real-Time Collision Detection 5.1.9):
-// parameters s (on the first) and t (on the second) in [0, 1].
-void closest_segments(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2, double& s, double& t) {
-  const Vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
-  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
-  const double eps = 1e-30;
-  if (a <= eps && e <= eps) {
-    s = t = 0;
-    return;
-  }
-  if (a <= eps) {
-    s = 0;
-    t = std::clamp(f / e, 0.0, 1.0);
-    return;
-  }
-  const double c = d1.dot(r);
-  if (e <= eps) {
-    t = 0;
-    s = std::clamp(-c / a, 0.0, 1.0);
-    return;
-  }
-  const double b = d1.dot(d2), denom = a * e - b * b;
-  s = denom > 0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
-  t = (b * s + f) / e;
-  if (t < 0) {
-    t = 0;
-    s = std::clamp(-c / a, 0.0, 1.0);
-  } else if (t > 1) {
-    t = 1;
-    s = std::clamp((b - c) / a, 0.0, 1.0);
-  }
-}
-
-// Does segment pq cross triangle abc (proper crossing; touching does not count)?
-bool segment_crosses_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 n = (b - a).cross(c - a);
-  const double dp = n.dot(p - a), dq = n.dot(q - a);
-  if ((dp > 0) == (dq > 0) || dp == 0 || dq == 0) return false;
-  const Vec3 d = q - p;
-  const double s1 = (a - p).cross(b - p).dot(d);
-  const double s2 = (b - p).cross(c - p).dot(d);
-  const double s3 = (c - p).cross(a - p).dot(d);
-  return (s1 > 0 && s2 > 0 && s3 > 0) || (s1 < 0 && s2 < 0 && s3 < 0);
-}
-
-// Barycentric coordinates of the projection of p onto the plane of abc, and the signed
-// distance along the unit normal n (b - a) x (c - a). False for a degenerate triangle.
-bool project_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Vec3& bary, Vec3& n,
-                         double& dist) {
-  const Vec3 e1 = b - a, e2 = c - a;
-  n = e1.cross(e2);
-  const double n2 = n.squaredNorm();
-  if (!(n2 > 1e-30)) return false;
-  const Vec3 ap = p - a;
-  const double w1 = ap.cross(e2).dot(n) / n2;  // weight of b
-  const double w2 = e1.cross(ap).dot(n) / n2;  // weight of c
-  bary = Vec3(1 - w1 - w2, w1, w2);
-  n /= std::sqrt(n2);
-  dist = ap.dot(n);
-  return true;
-}
 
 // Sorts pairs by (key0, key1) and drops repeats: a counting sort on key0 in [0, n) (linear in
 // the pair count; std::sort of the 100k-400k pairs of an HR detection took a third of it), then
@@ -135,9 +76,6 @@ class SpinLock {
  private:
   std::atomic_flag flag_ = ATOMIC_FLAG_INIT;
 };
-
-constexpr double kInside = -1e-3;  // barycentric tolerance: a vertex on a shared edge is guarded by both faces
-constexpr double kEdgeEnd = 1e-3;  // edge parameter tolerance for an interior edge-edge closest point
 
 }  // namespace
 
@@ -384,6 +322,11 @@ SelfCollision::SelfCollision(const gdsr::Faces& F, int num_vertices) : F_(F), em
       }
     }
   tangled_.assign(num_vertices, 0);
+  vertex_faces_ = gdsr::vertex_faces(F, num_vertices);
+  std::vector<std::vector<int>> vertex_edges(num_vertices);
+  for (int e = 0; e < static_cast<int>(edges_.size()); ++e)
+    for (int v : edges_[e]) vertex_edges[v].push_back(e);
+  vertex_edges_ = gdsr::build_csr(std::move(vertex_edges));
   // One broad-phase thread: Embree's own (TBB) threads beside the narrow phase's OpenMP ones
   // made 2-thread runs slower (1.09 against 0.93 s per HR frame on 0.3 s of CMU 01_01).
   embree_->device = rtcNewDevice("threads=1");
@@ -700,72 +643,6 @@ int SelfCollision::untangle(Points3& x, const std::vector<double>& winv, double 
     if (len > 0) x.row(v) += (len > step ? untangle_move_[v] * (step / len) : untangle_move_[v]).transpose();
   }
   return crossing;
-}
-
-int SelfCollision::project(Points3& x, const std::vector<double>& winv, double thickness, double max_crossed_push,
-                           double min_mass_share) {
-  int pushed = 0;
-  for (auto& c : vt_) {
-    const int ia = F_(c.f, 0), ib = F_(c.f, 1), ic = F_(c.f, 2);
-    const Vec3 p = x.row(c.v), a = x.row(ia), b = x.row(ib), cc = x.row(ic);
-    Vec3 bary, n;
-    double dist = 0;
-    if (!project_on_triangle(p, a, b, cc, bary, n, dist)) continue;
-    const bool free = tangled_[c.v] || tangled_[ia] || tangled_[ib] || tangled_[ic] || -c.side * dist > c.reach;
-    if (free || bary.minCoeff() < kInside) {  // crossing the plane is legal here: follow the geometry
-      if (dist != 0) c.side = dist > 0 ? 1 : -1;
-      continue;
-    }
-    const double C = std::max(c.side * dist - thickness, -max_crossed_push);
-    if (C >= 0) continue;
-    const double wp = winv[c.v], wa = winv[ia], wb = winv[ib], wc = winv[ic];
-    const double wsum = std::max(wp + bary.x() * bary.x() * wa + bary.y() * bary.y() * wb + bary.z() * bary.z() * wc,
-                                 min_mass_share * std::max({wp, wa, wb, wc}));
-    if (!(wsum > 0)) continue;
-    const Vec3 dir = (-C / wsum * c.side) * n;
-    x.row(c.v) += (wp * dir).transpose();
-    x.row(ia) -= (wa * bary.x() * dir).transpose();
-    x.row(ib) -= (wb * bary.y() * dir).transpose();
-    x.row(ic) -= (wc * bary.z() * dir).transpose();
-    ++pushed;
-  }
-  for (auto& c : ee_) {
-    const int i0 = edges_[c.a][0], i1 = edges_[c.a][1], j0 = edges_[c.b][0], j1 = edges_[c.b][1];
-    const Vec3 p1 = x.row(i0), q1 = x.row(i1), p2 = x.row(j0), q2 = x.row(j1);
-    double s = 0, t = 0;
-    closest_segments(p1, q1, p2, q2, s, t);
-    const Vec3 d = (p1 + s * (q1 - p1)) - (p2 + t * (q2 - p2));
-    const double len = d.norm();
-    Vec3 dir(c.dir[0], c.dir[1], c.dir[2]);
-    const bool free = tangled_[i0] || tangled_[i1] || tangled_[j0] || tangled_[j1] || -d.dot(dir) > c.reach;
-    const bool interior = s > kEdgeEnd && s < 1 - kEdgeEnd && t > kEdgeEnd && t < 1 - kEdgeEnd;
-    const double along = d.dot(dir);
-    if (free || !interior || dir.squaredNorm() == 0 || (along > 0 && len >= thickness)) {
-      // Free to move (or apart on the remembered side): the side follows the geometry.
-      if (len > 0) c.set_dir(d / len);
-      continue;
-    }
-    // Same side but too close: push along the current separation; crossed: push back
-    // along the remembered side.
-    Vec3 n = dir;
-    double C = std::max(along - thickness, -max_crossed_push);
-    if (along > 0 && len > 0) {
-      n = d / len;
-      C = len - thickness;
-      c.set_dir(n);
-    }
-    const double w0 = winv[i0], w1 = winv[i1], w2 = winv[j0], w3 = winv[j1];
-    const double wsum = std::max((1 - s) * (1 - s) * w0 + s * s * w1 + (1 - t) * (1 - t) * w2 + t * t * w3,
-                                 min_mass_share * std::max({w0, w1, w2, w3}));
-    if (!(wsum > 0)) continue;
-    const Vec3 step = (-C / wsum) * n;
-    x.row(i0) += (w0 * (1 - s) * step).transpose();
-    x.row(i1) += (w1 * s * step).transpose();
-    x.row(j0) -= (w2 * (1 - t) * step).transpose();
-    x.row(j1) -= (w3 * t * step).transpose();
-    ++pushed;
-  }
-  return pushed;
 }
 
 }  // namespace sim

@@ -38,9 +38,11 @@
 #pragma once
 
 #include "gdsr/geometry/mesh.hpp"
+#include "gdsr/geometry/mesh_ops.hpp"
 
 #include <algorithm>
 #include <array>
+#include <cstddef>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -90,6 +92,9 @@ class SelfCollision {
   // little of the contact point (the others pinned) the push does not move them by C over their
   // weight; pairs of free vertices of like masses are never below 0.25 (a vertex against a free
   // face: 1 + 1/3 and more; two free edges: 1 and more). Returns the number of pairs pushed.
+  // From kTwoThreadProjectPairs pairs (and two OpenMP threads allowed) the pass runs on two
+  // threads, with the one-thread result bit for bit (cloth_self_contact_projection.cpp).
+  static constexpr size_t kTwoThreadProjectPairs = 4096;
   int project(gdsr::Points3& x, const std::vector<double>& winv, double thickness,
               double max_crossed_push = std::numeric_limits<double>::infinity(), double min_mass_share = 0);
 
@@ -147,6 +152,32 @@ class SelfCollision {
   bool narrow_phase(const Narrow& n, int e, int f, std::array<int, 2>& out) const;
   // The kept pairs in a fixed order (the broad phase's is not), repeats dropped.
   void sort_pairs();
+  // The contact projection (cloth_self_contact_projection.cpp). project_pair: one pair's
+  // constraint at positions x; true if it pushes, with what the push adds to its four vertices
+  // in `out`; else at most the pair's remembered side changes.
+  struct ProjectLimits {
+    const std::vector<double>* winv;
+    double thickness, max_crossed_push, min_mass_share;
+  };
+  struct PairPush {
+    int v[4];
+    gdsr::Vec3 d[4];
+    void apply(gdsr::Points3& x) const {
+      for (int k = 0; k < 4; ++k) x.row(v[k]) += d[k].transpose();
+    }
+  };
+  bool project_pair(const gdsr::Points3& x, const ProjectLimits& l, VT& c, PairPush& out) const;
+  bool project_pair(const gdsr::Points3& x, const ProjectLimits& l, EE& c, PairPush& out) const;
+  template <class Pair> int project_in_order(gdsr::Points3& x, const ProjectLimits& l, std::vector<Pair>& pairs) const;
+  // The second phase (see the .cpp): `evaluated` and `pushes` hold the first phase's pairs and
+  // verdicts; `pairs` gets the pass's. moved_*: the vertices, faces and edges pushed so far this
+  // pass. `redone` counts the pairs evaluated again.
+  template <class Pair> int project_speculated(gdsr::Points3& x, const ProjectLimits& l, std::vector<Pair>& pairs,
+                                               std::vector<Pair>& evaluated, const std::vector<char>& pushes,
+                                               size_t& redone);
+  bool touches(const VT& c) const { return moved_v_[c.v] | moved_f_[c.f]; }
+  bool touches(const EE& c) const { return moved_e_[c.a] | moved_e_[c.b]; }
+  void mark_moved(const PairPush& push);
   gdsr::Faces F_;
   std::vector<std::array<int, 2>> edges_;  // unique edges (i < j)
   std::vector<std::array<int, 2>> edge_faces_;  // the (one or two) faces of each edge, -1: none
@@ -155,6 +186,12 @@ class SelfCollision {
   std::vector<VT> vt_;
   std::vector<EE> ee_;
   std::vector<char> tangled_;
+  std::vector<VT> speculated_vt_;  // project's first phase, kept to reuse the memory
+  std::vector<EE> speculated_ee_;
+  std::vector<char> pushes_vt_, pushes_ee_, moved_v_, moved_f_, moved_e_;
+  gdsr::Csr vertex_faces_, vertex_edges_;  // around each vertex, for moved_f_ and moved_e_
+  double last_redone_share_ = 0;           // of the pairs, by the last two-phase pass
+  int passes_in_order_ = 0;                // since then
   int intersecting_ = 0;
   long long detections_ = 0;
   long long redetections_ = 0;

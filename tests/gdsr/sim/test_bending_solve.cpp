@@ -4,7 +4,7 @@
 // the solver's assembled matrix), and the fixed vertices left where they were.
 #include <doctest/doctest.h>
 
-#include "tests/support/two_omp_threads.hpp"
+#include "tests/support/omp_threads.hpp"
 
 #include "gdsr/sim/cloth_bending_solve.hpp"
 #include "gdsr/error.hpp"

@@ -4,7 +4,7 @@
 // with a few long "seam" edges joining far-apart vertex numbers (as a garment's panels are).
 #include <doctest/doctest.h>
 
-#include "tests/support/two_omp_threads.hpp"
+#include "tests/support/omp_threads.hpp"
 
 #include "gdsr/sim/gauss_seidel_schedule.hpp"
 #include "gdsr/error.hpp"

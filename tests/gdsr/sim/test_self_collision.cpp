@@ -6,6 +6,8 @@
 #include <utility>
 
 #include "tests/support/cloth_bodies.hpp"
+#include "tests/support/crumpled_sheets.hpp"
+#include "tests/support/omp_threads.hpp"
 #include "tests/support/square_cloth.hpp"
 #include "gdsr/sim/cloth_self_collision.hpp"
 #include "gdsr/sim/cloth_solver.hpp"
@@ -34,23 +36,6 @@ namespace {
 // Horizontal square sheet (side m) at height y centred over x = z = 0 at particle distance h.
 gdsr::GarmentMesh sheet(double side, double h, double y) { return gdsr_test::square_cloth(side, h, y).mesh; }
 
-// Two meshes as one garment (UV of b shifted so the pattern pieces do not overlap).
-gdsr::GarmentMesh merge(const gdsr::GarmentMesh& a, const gdsr::GarmentMesh& b) {
-  gdsr::GarmentMesh m;
-  const int nv = static_cast<int>(a.V.rows()), nuv = static_cast<int>(a.UV.rows());
-  m.V.resize(nv + b.V.rows(), 3);
-  m.V << a.V, b.V;
-  m.UV.resize(nuv + b.UV.rows(), 2);
-  m.UV << a.UV, (b.UV.rowwise() + Eigen::RowVector2d(10, 0));
-  m.F.resize(a.F.rows() + b.F.rows(), 3);
-  m.F << a.F, (b.F.array() + nv).matrix();
-  m.FUV.resize(a.FUV.rows() + b.FUV.rows(), 3);
-  m.FUV << a.FUV, (b.FUV.array() + nuv).matrix();
-  m.uv_to_vertex = a.uv_to_vertex;
-  for (int u : b.uv_to_vertex) m.uv_to_vertex.push_back(u + nv);
-  return m;
-}
-
 // Lower sheet (0.5 m, nl vertices first) clamped along its border (no body: pinned vertices
 // are fixed); the upper sheet, smaller and turned, 0.3 m above it, at particle distance h.
 sim::Garment two_sheets(double h, int& nl) {
@@ -65,7 +50,7 @@ sim::Garment two_sheets(double h, int& nl) {
   sim::Garment g;
   g.name = "two sheets";
   g.particle_distance = h;
-  g.mesh = merge(lower, upper);
+  g.mesh = gdsr_test::merge_garment_meshes(lower, upper);
   nl = static_cast<int>(lower.V.rows());
   for (int v = 0; v < nl; ++v)
     if (std::max(std::abs(lower.V(v, 0)), std::abs(lower.V(v, 2))) > 0.25 - 1e-9) g.pinned.push_back(v);
@@ -99,7 +84,7 @@ sim::Garment flap_through_sheet() {
   sim::Garment g;
   g.name = "flap";
   g.particle_distance = h;
-  g.mesh = merge(lower, upper);
+  g.mesh = gdsr_test::merge_garment_meshes(lower, upper);
   for (int v = 0; v < lower.V.rows(); ++v)
     if (std::max(std::abs(lower.V(v, 0)), std::abs(lower.V(v, 2))) > 0.2 - 1e-9) g.pinned.push_back(v);
   return g;
@@ -113,7 +98,7 @@ TEST_CASE("self-collision: the CGAL yardstick counts crossing triangles and igno
   // A second sheet standing vertically through the first one crosses it.
   auto b = sheet(0.2, 0.05, 0.0);
   for (int v = 0; v < b.V.rows(); ++v) b.V.row(v) = Vec3(b.V(v, 0) + 0.013, b.V(v, 2) + 0.011, 0.007).transpose();
-  const auto m = merge(a, b);
+  const auto m = gdsr_test::merge_garment_meshes(a, b);
   CHECK(!(gdsr::self_intersections(m.V, m.F).pairs == 0));
 }
 
@@ -140,23 +125,7 @@ double segment_distance(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Ve
   return to_second(0.5 * (lo + hi));
 }
 
-// Two crumpled 20 cm sheets 4 mm apart at 10 mm (random offsets up to 3 mm per axis), with
-// random motions (up to 2 mm per axis).
-struct CrumpledSheets {
-  gdsr::GarmentMesh m;
-  Points3 x, motion;
-  explicit CrumpledSheets(unsigned seed) : m(merge(sheet(0.2, 0.01, 0.0), sheet(0.2, 0.01, 0.004))) {
-    const int nv = static_cast<int>(m.V.rows());
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> u(-1, 1);
-    x = m.V;
-    motion.resize(nv, 3);
-    for (int v = 0; v < nv; ++v) {
-      x.row(v) += 0.003 * Eigen::RowVector3d(u(rng), u(rng), u(rng));
-      motion.row(v) = 0.002 * Eigen::RowVector3d(u(rng), u(rng), u(rng));
-    }
-  }
-};
+using gdsr_test::CrumpledSheets;
 
 // Paths for a redetect `half` through the interval: 5% of the vertices (drawn with `seed`) leave
 // their paths for new motions of up to 2 mm (moved, rest); the others go on along theirs.
@@ -455,7 +424,7 @@ TEST_CASE("self-collision: the detector flags crossing triangles as tangled") {
   auto a = sheet(0.2, 0.05, 0.0);
   auto b = sheet(0.2, 0.05, 0.0);
   for (int v = 0; v < b.V.rows(); ++v) b.V.row(v) = Vec3(b.V(v, 0) + 0.013, b.V(v, 2) + 0.011, 0.007).transpose();
-  const auto m = merge(a, b);
+  const auto m = gdsr_test::merge_garment_meshes(a, b);
   sim::SelfCollision sc(m.F, static_cast<int>(m.V.rows()));
   sc.detect(m.V, Points3::Zero(m.V.rows(), 3), 0.0, 0.003);
   CHECK(sc.num_intersecting_pairs() > 0);
@@ -477,7 +446,7 @@ TEST_CASE("self-collision: contour minimisation pulls a bump back through the sh
     const double r = std::hypot(b.V(v, 0) - 0.004, b.V(v, 2) + 0.003);
     if (r < 0.025) b.V(v, 1) += 0.025 * std::cos(r / 0.025 * 1.5707963);
   }
-  const auto m = merge(a, b);
+  const auto m = gdsr_test::merge_garment_meshes(a, b);
   const int na = static_cast<int>(a.V.rows()), nv = static_cast<int>(m.V.rows());
   std::vector<double> winv(nv, 1.0);
   for (int v = 0; v < na; ++v)
@@ -594,7 +563,7 @@ TEST_CASE("self-collision: cloth falling together is detected on schedule, cloth
       sim::Garment g;
       g.name = "falling sheets";
       g.particle_distance = h;
-      g.mesh = merge(sheet(0.5, h, 0.0), sheet(0.36, h, 1.0));
+      g.mesh = gdsr_test::merge_garment_meshes(sheet(0.5, h, 0.0), sheet(0.36, h, 1.0));
       const int nl = static_cast<int>(sheet(0.5, h, 0.0).V.rows());
       if (held)
         for (int v = 0; v < nl; ++v) g.pinned.push_back(v);
@@ -748,6 +717,41 @@ TEST_CASE(
   CHECK((floored.row(2) - x.row(2)).norm() == doctest::Approx(0.05 * 0.001 / 0.25).epsilon(1e-6));
   CHECK((floored.topRows(2) - x.topRows(2)).norm() == 0);
   CHECK((floored.row(3) - x.row(3)).norm() == 0);
+}
+
+TEST_CASE("self-collision: the projection on two threads gives the one-thread passes bit for bit") {
+  // The crumpled sheets (seed 8) detected 5 mm thick, then pressed together (the upper sheet
+  // 2 mm lower): most pairs are too close, many are pushed, and the pushes move vertices that
+  // later pairs read. Every 17th vertex pinned (inverse mass 0), the crossed-push cap and the mass
+  // floor on, as the solver calls it. Five passes on two threads (the first phase evaluates
+  // every pair at the pass's starting positions, the second redoes the pairs a push has
+  // touched) against five on one: the same positions bit for bit, the same counts pushed.
+  const CrumpledSheets sheets(8);
+  const auto& m = sheets.m;
+  const int nv = static_cast<int>(m.V.rows());
+  const double thickness = 0.005, slack = 0.001;
+  std::vector<double> winv(nv, 1.0);
+  for (int v = 0; v < nv; v += 17) winv[v] = 0;
+  Points3 pressed = sheets.x;
+  for (int v = nv / 2; v < nv; ++v) pressed(v, 1) -= 0.002;  // the upper sheet: the second half
+  auto passes = [&](int threads, std::vector<int>& pushed) {
+    const sim::OmpThreads scope(threads);
+    sim::SelfCollision sc(m.F, nv);
+    sc.detect(sheets.x, sheets.motion, slack, thickness);
+    REQUIRE(static_cast<size_t>(sc.num_vertex_triangle() + sc.num_edge_edge()) >=
+            sim::SelfCollision::kTwoThreadProjectPairs);
+    Points3 y = pressed;
+    for (int k = 0; k < 5; ++k) pushed.push_back(sc.project(y, winv, thickness, thickness, 0.25));
+    return y;
+  };
+  std::vector<int> pushed1, pushed2;
+  const Points3 one = passes(1, pushed1), two = passes(2, pushed2);
+  MESSAGE("pairs pushed per pass: " << pushed1[0] << " " << pushed1[1] << " " << pushed1[4]);
+  CHECK(pushed1[0] > 300);
+  CHECK(pushed1[4] > 0);  // still pushing: each pass starts from the last one's moves
+  CHECK((one - pressed).cwiseAbs().maxCoeff() > 1e-3);
+  CHECK(pushed2 == pushed1);
+  CHECK((two - one).cwiseAbs().maxCoeff() == 0.0);
 }
 
 TEST_CASE("self-collision: resting layers are kept the larger of the thickness and a sixth of the particle distance apart") {
