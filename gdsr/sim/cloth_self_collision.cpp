@@ -3,7 +3,6 @@
 #include "gdsr/sim/contact_geometry.hpp"
 
 #include "gdsr/error.hpp"
-#include "gdsr/geometry/mesh_ops.hpp"
 #include "gdsr/geometry/triangle.hpp"
 
 #include <embree3/rtcore.h>
