@@ -89,6 +89,16 @@ Csr build_csr(std::vector<std::vector<int>>&& lists) {
   return c;
 }
 
+Csr vertex_edges(const std::vector<std::array<int, 2>>& ends, int num_vertices) {
+  std::vector<std::vector<int>> lists(static_cast<size_t>(num_vertices));
+  for (int e = 0; e < static_cast<int>(ends.size()); ++e)
+    for (int v : ends[e]) {
+      if (v < 0 || v >= num_vertices) gdsr::fail("vertex_edges", "edge end out of range");
+      lists[v].push_back(e);
+    }
+  return build_csr(std::move(lists));
+}
+
 Csr vertex_faces(const Faces& F, int num_vertices) {
   std::vector<std::vector<int>> lists(static_cast<size_t>(num_vertices));
   for (int f = 0; f < F.rows(); ++f)

@@ -6,6 +6,7 @@
 #include "gdsr/geometry/mesh.hpp"
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 namespace gdsr {
@@ -34,6 +35,8 @@ struct Csr {
 Csr build_csr(std::vector<std::vector<int>>&& lists);      // list v becomes the items of vertex v, in order
 Csr vertex_faces(const Faces& F, int num_vertices);       // faces around each vertex, ascending
 Csr vertex_neighbours(const Faces& F, int num_vertices);  // ring-1 vertices, ascending
+// Edges at each vertex, ascending: edge e (ends[e], any two vertices) is an item of both its ends.
+Csr vertex_edges(const std::vector<std::array<int, 2>>& ends, int num_vertices);
 
 // Pairs of faces sharing an edge (manifold interior edges; an edge with more than two faces
 // yields a pair for each consecutive pair of faces). For pair p: faces(p) = (f0, f1),

@@ -139,9 +139,9 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     bends_.push_back(b);
   }
 
-  std::vector<std::vector<int>> edges_at(static_cast<size_t>(m.V.rows()));
-  for (int e = 0; e < static_cast<int>(edges_.size()); ++e) edges_at[edges_[e].i].push_back(e), edges_at[edges_[e].j].push_back(e);
-  vertex_edges_ = gdsr::build_csr(std::move(edges_at));
+  std::vector<std::array<int, 2>> edge_ends_ij(edges_.size());
+  for (size_t e = 0; e < edges_.size(); ++e) edge_ends_ij[e] = {edges_[e].i, edges_[e].j};
+  vertex_edges_ = gdsr::vertex_edges(edge_ends_ij, static_cast<int>(m.V.rows()));
   std::vector<GaussSeidelSchedule::Item> edge_ends(edges_.size());
   for (size_t e = 0; e < edges_.size(); ++e) edge_ends[e] = {edges_[e].i, edges_[e].j, -1, -1};
   edge_schedule_.plan(edge_ends, nv);

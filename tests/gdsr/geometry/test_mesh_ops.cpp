@@ -8,6 +8,7 @@
 #include <cmath>
 #include <queue>
 #include <random>
+#include <array>
 #include <set>
 
 using namespace gdsr;
@@ -111,6 +112,26 @@ TEST_CASE("mesh_ops: vertex-face adjacency lists every incidence once") {
       CHECK((g.F(f, 0) == v || g.F(f, 1) == v || g.F(f, 2) == v));
     }
   CHECK_THROWS_AS(vertex_faces(g.F, 3), std::runtime_error);
+}
+
+TEST_CASE("mesh_ops: vertex-edge adjacency lists each edge at both its ends, ascending") {
+  const GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec(4, 4, 1.0, 1.0).tube());
+  const int nv = static_cast<int>(g.V.rows());
+  const Pairs E = unique_edges(g.F);
+  std::vector<std::array<int, 2>> ends(E.rows());
+  for (int e = 0; e < E.rows(); ++e) ends[e] = {E(e, 1), E(e, 0)};  // either order of the ends
+  const Csr ve = vertex_edges(ends, nv);
+  CHECK(ve.items.size() == 2 * ends.size());
+  for (int v = 0; v < nv; ++v) {
+    int degree = 0;  // from the faces: a closed-ring neighbour count
+    for (int e = 0; e < E.rows(); ++e) degree += E(e, 0) == v || E(e, 1) == v;
+    CHECK(ve.count(v) == degree);
+    for (int a = ve.offsets[v]; a < ve.offsets[v + 1]; ++a) {
+      CHECK((ends[ve.items[a]][0] == v || ends[ve.items[a]][1] == v));
+      if (a > ve.offsets[v]) CHECK(ve.items[a - 1] < ve.items[a]);
+    }
+  }
+  CHECK_THROWS_AS(vertex_edges({{0, nv}}, nv), std::runtime_error);
 }
 
 TEST_CASE("mesh_ops: triangle frames follow the reference convention") {
