@@ -142,22 +142,31 @@ struct SelfCollision::Embree {
     release_kept();
     if (device) rtcReleaseDevice(device);
   }
+  // Each vertex's path box as floats rounded outwards (lower x, y, z, upper x, y, z), taken
+  // once per scene set (vertex_boxes) after x, motion, pad and the frame are set: a primitive's
+  // box is the union of its vertices' (rounding is monotonic, so the union of the rounded boxes
+  // is the rounded union, bit for bit). Taken per primitive, the trees' builds and refits took
+  // 8.5 s of CPU over 0.5 s of the HR and LR t-shirt on salsa 60_02, now 5.6 s.
+  std::vector<std::array<float, 6>> vertex_box;
+  void vertex_boxes() {
+    vertex_box.resize(x->rows());
+    for (long v = 0; v < x->rows(); ++v)
+      for (int c = 0; c < 3; ++c) {
+        const double a = (*x)(v, c) - frame_start[c];
+        const double b = motion ? a + (*motion)(v, c) - frame_motion[c] : a;
+        vertex_box[v][c] = std::nextafter(static_cast<float>(std::min(a, b) - pad), -1e30f);
+        vertex_box[v][3 + c] = std::nextafter(static_cast<float>(std::max(a, b) + pad), 1e30f);
+      }
+  }
   // Box of the paths of vertices ids[0..n).
   void bounds(const int* ids, int n, RTCBounds* o) const {
-    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-    for (int k = 0; k < n; ++k)
+    std::array<float, 6> b = vertex_box[ids[0]];
+    for (int k = 1; k < n; ++k)
       for (int c = 0; c < 3; ++c) {
-        const double a = (*x)(ids[k], c) - frame_start[c];
-        const double b = motion ? a + (*motion)(ids[k], c) - frame_motion[c] : a;
-        lo[c] = std::min(lo[c], std::min(a, b) - pad);
-        hi[c] = std::max(hi[c], std::max(a, b) + pad);
+        b[c] = std::min(b[c], vertex_box[ids[k]][c]);
+        b[3 + c] = std::max(b[3 + c], vertex_box[ids[k]][3 + c]);
       }
-    o->lower_x = std::nextafter(static_cast<float>(lo[0]), -1e30f);  // float box, rounded outwards
-    o->lower_y = std::nextafter(static_cast<float>(lo[1]), -1e30f);
-    o->lower_z = std::nextafter(static_cast<float>(lo[2]), -1e30f);
-    o->upper_x = std::nextafter(static_cast<float>(hi[0]), 1e30f);
-    o->upper_y = std::nextafter(static_cast<float>(hi[1]), 1e30f);
-    o->upper_z = std::nextafter(static_cast<float>(hi[2]), 1e30f);
+    *o = RTCBounds{b[0], b[1], b[2], 0, b[3], b[4], b[5], 0};
   }
   // Bounds callback of every scene: the primitive's path box, also stored in prims.
   static void prim_bounds(const RTCBoundsFunctionArguments* a) {
@@ -378,6 +387,7 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     E.pad = 0;
     E.frame_start.setZero();
     E.frame_motion.setZero();
+    E.vertex_boxes();
     // Two halves of the edges against the faces, on two threads.
     ScenesGuard g;  // s[0], s[1]: the halves of the edges; s[2]: the faces
     const int half = ne / 2;
@@ -403,11 +413,16 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
   E.frame_start.setZero();
   E.frame_motion = motion.colwise().mean().transpose();  // (nf >= 2: motion has rows)
   E.detect_frame_motion = E.frame_motion;
+  E.vertex_boxes();
   {
     // Vertex-face and edge-edge pairs on two threads (Embree's device runs one thread per
     // call), as jobs taken in turn: the vertex-face pairs, then every pair of edge chunks
     // (each unordered pair of edges once, as one scene collided with itself would give them),
-    // the largest jobs first. Edge-edge pairs are 2.5x the work of vertex-face ones.
+    // the largest jobs first: each chunk with itself (edges of near ids are near each other: on
+    // the t-shirt on salsa 60_02 these hold 80% of the edge-edge pairs kept, 7.7x the work of all the
+    // pairs of two chunks) before the pairs of chunks, so that neither thread waits long for the
+    // other's last job (the other way round, the jobs' CPU time was 0.93 of twice their wall
+    // time, now 0.98: 3% less wall time in the collides).
     RTCScene* sc = E.kept;  // [0] vertices, [1] faces, [2 + c] edge chunk c; kept for redetect
     run_jobs(2 + K, [&](int k) {
       if (k == 0)
@@ -420,10 +435,10 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     std::vector<std::array<int, 2>> jobs = {{-1, -1}};             // (-1, -1): vertex-face; (c, d): edge chunks c <= d
     auto empty = [&](int c) { return first[c + 1] == first[c]; };  // (Embree's collide crashed on an empty scene)
     for (int c = 0; c < K; ++c)
+      if (!empty(c)) jobs.push_back({c, c});
+    for (int c = 0; c < K; ++c)
       for (int d = c + 1; d < K; ++d)
         if (!empty(c) && !empty(d)) jobs.push_back({c, d});
-    for (int c = 0; c < K; ++c)
-      if (!empty(c)) jobs.push_back({c, c});
     const int njobs = static_cast<int>(jobs.size());
     std::vector<std::vector<EE>> ee_parts(jobs.size());
     run_jobs(njobs, [&](int k) {
@@ -473,6 +488,7 @@ void SelfCollision::redetect(const Points3& x, const Points3& start, const Point
   E.frame_start = elapsed * E.detect_frame_motion;
   E.frame_motion = (1 - elapsed) * E.detect_frame_motion;
   E.owner = this;
+  E.vertex_boxes();
   const Embree::PrimList lists[3] = {{&E, 0, 0, ids[0].data()}, {&E, 1, 0, ids[1].data()}, {&E, 2, 0, ids[2].data()}};
   ScenesGuard g;  // s[k]: the moved primitives of kind k
   run_jobs(3, [&](int k) {
