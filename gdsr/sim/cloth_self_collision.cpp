@@ -78,20 +78,12 @@ class SpinLock {
 
 }  // namespace
 
-// Embree device, the per-detection inputs of the bounds callbacks and the collected pairs.
-// Three primitive sets, each a user geometry in its own scene: vertices, edges and faces,
-// each bounded by its vertices' paths (x to x + motion) grown by `pad`.
+// Embree device, the per-detection vertex boxes the bounds callbacks read and the collected
+// pairs. Three primitive sets, each a user geometry in its own scene: vertices, edges and faces,
+// each bounded by its vertices' path boxes (vertex_boxes).
 struct SelfCollision::Embree {
   RTCDevice device = nullptr;
-  const Points3* x = nullptr;
-  const Points3* motion = nullptr;  // null: boxes of the current positions only
-  double pad = 0;
-  // The boxes are taken in a frame that moves along with the cloth: a path x + a motion is
-  // boxed as x - frame_start + a (motion - frame_motion), a in [0, 1]. The same shift for every
-  // primitive leaves each pair's relative motion as it was, so the test stays conservative,
-  // but the boxes of cloth carried along by a limb or the turning body stay short.
-  Vec3 frame_start = Vec3::Zero(), frame_motion = Vec3::Zero();
-  Vec3 detect_frame_motion = Vec3::Zero();  // frame_motion of the last detect (redetect continues it)
+  Vec3 detect_frame_motion = Vec3::Zero();  // the boxes frame's motion at the last detect (redetect continues it)
   const SelfCollision* owner = nullptr;
   // Per kind (vertices, edges, faces): each primitive's box in the last scene built of it,
   // written by the bounds callbacks, beside its vertex ids (one, two or three; -1 for none), so
@@ -142,17 +134,22 @@ struct SelfCollision::Embree {
     release_kept();
     if (device) rtcReleaseDevice(device);
   }
-  // Each vertex's path box as floats rounded outwards (lower x, y, z, upper x, y, z), taken
-  // once per scene set (vertex_boxes) after x, motion, pad and the frame are set: a primitive's
-  // box is the union of its vertices' (rounding is monotonic, so the union of the rounded boxes
-  // is the rounded union, bit for bit). Taken per primitive, the trees' builds and refits took
-  // 8.5 s of CPU over 0.5 s of the HR and LR t-shirt on salsa 60_02, now 5.6 s.
+  // Each vertex's path box as floats rounded outwards (lower x, y, z, upper x, y, z), set by
+  // vertex_boxes before the scenes are built or refitted: a primitive's box is the union of its
+  // vertices' (rounding is monotonic, so the union of the rounded boxes is the rounded union, bit
+  // for bit). Taken per primitive, the trees' builds and refits took 8.5 s of CPU over 0.5 s of
+  // the HR and LR t-shirt on salsa 60_02, now 5.6 s.
   std::vector<std::array<float, 6>> vertex_box;
-  void vertex_boxes() {
-    vertex_box.resize(x->rows());
-    for (long v = 0; v < x->rows(); ++v)
+  // The path x + a motion, a in [0, 1] (motion null: x alone), grown by pad, is boxed in a frame
+  // that moves along with the cloth: as x - frame_start + a (motion - frame_motion). The same
+  // shift for every primitive leaves each pair's relative motion as it was, so the test stays
+  // conservative, but the boxes of cloth carried along by a limb or the turning body stay short.
+  void vertex_boxes(const Points3& x, const Points3* motion, double pad, const Vec3& frame_start,
+                    const Vec3& frame_motion) {
+    vertex_box.resize(x.rows());
+    for (long v = 0; v < x.rows(); ++v)
       for (int c = 0; c < 3; ++c) {
-        const double a = (*x)(v, c) - frame_start[c];
+        const double a = x(v, c) - frame_start[c];
         const double b = motion ? a + (*motion)(v, c) - frame_motion[c] : a;
         vertex_box[v][c] = std::nextafter(static_cast<float>(std::min(a, b) - pad), -1e30f);
         vertex_box[v][3 + c] = std::nextafter(static_cast<float>(std::max(a, b) + pad), 1e30f);
@@ -361,9 +358,7 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
 
   // Broad phase: vertex, edge and face path boxes (Embree BVHs), collided pairwise.
   auto& E = *embree_;
-  E.x = &x;
-  E.motion = &motion;
-  E.pad = 0.5 * thickness + slack;
+  const double pad = 0.5 * thickness + slack;
   E.owner = this;
   E.prims[0].resize(nv);
   E.prims[1].resize(ne);
@@ -383,11 +378,7 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
     // An edge crossing a face now: tight boxes of the current positions (the swept, padded
     // boxes below would pass several times more candidates for the same exact test). First,
     // so that the edge and face boxes left in E.prims are the swept ones redetect relies on.
-    E.motion = nullptr;
-    E.pad = 0;
-    E.frame_start.setZero();
-    E.frame_motion.setZero();
-    E.vertex_boxes();
+    E.vertex_boxes(x, nullptr, 0, Vec3::Zero(), Vec3::Zero());
     // Two halves of the edges against the faces, on two threads.
     ScenesGuard g;  // s[0], s[1]: the halves of the edges; s[2]: the faces
     const int half = ne / 2;
@@ -408,12 +399,8 @@ void SelfCollision::detect(const Points3& x, const Points3& motion, double slack
       for (int i = 0; i < 3; ++i) tangled_[F_(f, i)] = 1;
     }
   }
-  E.motion = &motion;
-  E.pad = 0.5 * thickness + slack;
-  E.frame_start.setZero();
-  E.frame_motion = motion.colwise().mean().transpose();  // (nf >= 2: motion has rows)
-  E.detect_frame_motion = E.frame_motion;
-  E.vertex_boxes();
+  E.detect_frame_motion = motion.colwise().mean().transpose();  // (nf >= 2: motion has rows)
+  E.vertex_boxes(x, &motion, pad, Vec3::Zero(), E.detect_frame_motion);
   {
     // Vertex-face and edge-edge pairs on two threads (Embree's device runs one thread per
     // call), as jobs taken in turn: the vertex-face pairs, then every pair of edge chunks
@@ -482,13 +469,9 @@ void SelfCollision::redetect(const Points3& x, const Points3& start, const Point
   ee_.erase(std::remove_if(ee_.begin(), ee_.end(), [&](const EE& c) { return moved_e[c.a] || moved_e[c.b]; }),
             ee_.end());
 
-  E.x = &start;
-  E.motion = &motion;
-  E.pad = 0.5 * thickness + slack;
-  E.frame_start = elapsed * E.detect_frame_motion;
-  E.frame_motion = (1 - elapsed) * E.detect_frame_motion;
   E.owner = this;
-  E.vertex_boxes();
+  E.vertex_boxes(start, &motion, 0.5 * thickness + slack, elapsed * E.detect_frame_motion,
+                 (1 - elapsed) * E.detect_frame_motion);
   const Embree::PrimList lists[3] = {{&E, 0, 0, ids[0].data()}, {&E, 1, 0, ids[1].data()}, {&E, 2, 0, ids[2].data()}};
   ScenesGuard g;  // s[k]: the moved primitives of kind k
   run_jobs(3, [&](int k) {
