@@ -21,6 +21,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <chrono>
 #include <ctime>
@@ -29,6 +30,9 @@
 #include <iostream>
 #include <memory>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace {
 
@@ -428,6 +432,7 @@ struct PreviewArgs {
   int size = 512;
   bool body = true;
   bool intersections = false;  // paint the faces of intersecting pairs red
+  bool penetration = false;    // paint the faces inside the body (outside pinches magenta, pinched cyan)
   std::string view = "front";  // where the camera is, relative to the body's first pose (Y-up, facing +z)
 };
 
@@ -452,20 +457,74 @@ void set_view(const std::string& view, gdsr::RenderOptions& opt) {
     }
 }
 
-// The garment as two meshes: the faces in no intersecting pair, and those in one (CGAL).
-std::vector<gdsr::TriMesh> split_by_intersections(const gdsr::TriMesh& g, int& marked) {
+// Labels of the garment's faces for --intersections and --penetration, one colour each.
+enum FaceMark { kPlain, kPinched, kInBody, kIntersecting, kMarks };
+
+// Marks the faces in an intersecting pair (CGAL); returns how many.
+int mark_intersections(const gdsr::TriMesh& g, std::vector<int>& mark) {
   const gdsr::SelfIntersections si = gdsr::self_intersections(g.V, g.F, /*list_pairs=*/true);
-  std::vector<char> hit(g.F.rows(), 0);
-  for (const auto& [f, h] : si.list) hit[f] = hit[h] = 1;
-  marked = static_cast<int>(std::count(hit.begin(), hit.end(), 1));
-  std::vector<gdsr::TriMesh> parts(2, gdsr::TriMesh{g.V, gdsr::Faces(0, 3)});
-  for (int k = 0; k < 2; ++k) {
-    parts[k].F.resize(k ? marked : g.F.rows() - marked, 3);
-    int n = 0;
-    for (int f = 0; f < g.F.rows(); ++f)
-      if (hit[f] == k) parts[k].F.row(n++) = g.F.row(f);
+  int marked = 0;
+  for (const auto& [f, h] : si.list)
+    for (int k : {f, h}) marked += std::exchange(mark[k], kIntersecting) != kIntersecting;
+  return marked;
+}
+
+// Marks the faces with a corner deeper than opt.penetration_limit in the body in frame t:
+// kInBody if one such corner is outside pinches, else kPinched (gdsr::body_depths, the rule of
+// `data check`). Faces already marked keep their mark.
+struct InBody {
+  int faces = 0, pinched = 0;  // faces marked kInBody / kPinched (whatever mark they kept)
+  double deepest = 0;          // metres, deepest corner outside pinches (0: none past the limit)
+};
+InBody mark_penetration(const gdsr::Dataset& d, int t, const gdsr::TriMesh& g, std::vector<int>& mark) {
+  const gdsr::ValidityOptions opt;
+  const gdsr::BodyDepths bd = gdsr::body_depths(d, t, g.V, opt);
+  InBody r;
+  for (int f = 0; f < g.F.rows(); ++f) {
+    int m = kPlain;
+    for (int k = 0; k < 3; ++k) {
+      const int v = g.F(f, k);
+      if (!(bd.depth[v] > opt.penetration_limit)) continue;
+      m = std::max(m, bd.pinched[v] ? int{kPinched} : int{kInBody});
+      if (!bd.pinched[v]) r.deepest = std::max(r.deepest, bd.depth[v]);
+    }
+    r.faces += m == kInBody;
+    r.pinched += m == kPinched;
+    if (mark[f] == kPlain) mark[f] = m;
   }
-  return parts;
+  return r;
+}
+
+// The garment as one mesh per mark (empty meshes left out: the renderer refuses them).
+void add_marked(const gdsr::TriMesh& g, const std::vector<int>& mark, const std::array<cv::Vec3b, kMarks>& colour,
+                std::vector<gdsr::TriMesh>& meshes, std::vector<cv::Vec3b>& colours) {
+  for (int m = 0; m < kMarks; ++m) {
+    const int n = static_cast<int>(std::count(mark.begin(), mark.end(), m));
+    if (n == 0) continue;
+    gdsr::TriMesh part{g.V, gdsr::Faces(n, 3)};
+    for (int f = 0, i = 0; f < g.F.rows(); ++f)
+      if (mark[f] == m) part.F.row(i++) = g.F.row(f);
+    meshes.push_back(std::move(part));
+    colours.push_back(colour[m]);
+  }
+}
+
+// X-ray: the faces marked kPinched or kInBody drawn over img (rendered with opt) at 65%
+// opacity, so that the body that hides them does not.
+void draw_through(const gdsr::TriMesh& g, std::vector<int> mark, const std::array<cv::Vec3b, kMarks>& colour,
+                  const gdsr::RenderOptions& opt, cv::Mat& img) {
+  for (int& m : mark)
+    if (m != kPinched && m != kInBody) m = -1;
+  std::vector<gdsr::TriMesh> parts;
+  std::vector<cv::Vec3b> colours;
+  add_marked(g, mark, colour, parts, colours);
+  if (parts.empty()) return;
+  const cv::Mat over = gdsr::render_meshes(parts, colours, opt);
+  const cv::Scalar bg(opt.background[0], opt.background[1], opt.background[2]);
+  cv::Mat empty, blend;
+  cv::inRange(over, bg, bg, empty);
+  cv::addWeighted(img, 0.35, over, 0.65, 0, blend);
+  blend.copyTo(img, ~empty);
 }
 
 void run_preview(const PreviewArgs& a) {
@@ -487,28 +546,29 @@ void run_preview(const PreviewArgs& a) {
   const cv::Vec3b body_c(200, 200, 200), lr_c(70, 120, 230), hr_c(60, 170, 90);  // BGR
   std::vector<gdsr::TriMesh> with_body;
   if (a.body && d.has_body()) with_body.push_back(gdsr::TriMesh{d.body_frames[t], d.body_faces});
-  const cv::Vec3b hit_c(40, 40, 220);
+  if (a.penetration && !d.has_body()) gdsr::fail("--penetration", a.data + " has no body");
   const std::string view_note = a.view == "front" ? "" : ", " + a.view;
   std::string lr_note = view_note, hr_note = view_note;
-  auto render = [&](const gdsr::TriMesh& g, const cv::Vec3b& c, std::string& note) {
+  auto render = [&](const char* name, const gdsr::TriMesh& g, const cv::Vec3b& c, std::string& note) {
     std::vector<gdsr::TriMesh> meshes = with_body;
     std::vector<cv::Vec3b> colours(with_body.size(), body_c);
-    if (a.intersections) {
-      int marked = 0;
-      const std::vector<gdsr::TriMesh> parts = split_by_intersections(g, marked);
-      for (int k = 0; k < 2; ++k)
-        if (parts[k].F.rows() > 0) {  // the renderer refuses empty meshes
-          meshes.push_back(parts[k]);
-          colours.push_back(k ? hit_c : c);
-        }
-      note += ", " + std::to_string(marked) + " faces intersect";
-    } else {
-      meshes.push_back(g);
-      colours.push_back(c);
+    std::vector<int> mark(g.F.rows(), kPlain);
+    if (a.intersections) note += ", " + std::to_string(mark_intersections(g, mark)) + " faces intersect";
+    if (a.penetration) {
+      const InBody in = mark_penetration(d, t, g, mark);
+      note += ", " + std::to_string(in.faces) + " in body (" + std::to_string(in.pinched) + " pinched)";
+      std::printf("%s: %d faces with a corner > %g mm in the body outside pinches (deepest %.1f mm), %d pinched\n",
+                  name, in.faces, 1000 * gdsr::ValidityOptions{}.penetration_limit, 1000 * in.deepest, in.pinched);
     }
-    return gdsr::render_meshes(meshes, colours, opt);
+    // BGR: cloth, pinched cyan, in the body magenta, intersecting red.
+    const std::array<cv::Vec3b, kMarks> colour = {c, cv::Vec3b(230, 200, 0), cv::Vec3b(200, 40, 200),
+                                                  cv::Vec3b(40, 40, 220)};
+    add_marked(g, mark, colour, meshes, colours);
+    cv::Mat img = gdsr::render_meshes(meshes, colours, opt);
+    draw_through(g, mark, colour, opt, img);
+    return img;
   };
-  const cv::Mat lr_img = render(lr, lr_c, lr_note), hr_img = render(hr, hr_c, hr_note);
+  const cv::Mat lr_img = render("LR", lr, lr_c, lr_note), hr_img = render("HR", hr, hr_c, hr_note);
   const cv::Mat img = gdsr::side_by_side(
       {lr_img, hr_img}, {"LR " + std::to_string(lr.num_vertices()) + " verts, frame " + std::to_string(t) + lr_note,
                          "HR " + std::to_string(hr.num_vertices()) + " verts, frame " + std::to_string(t) + hr_note});
@@ -776,6 +836,9 @@ void add_data_command(CLI::App& app) {
   prev->add_option("--size", pv->size, "pixels per image side")->capture_default_str()->check(CLI::Range(16, 8192));
   prev->add_flag("!--no-body", pv->body, "leave the body out");
   prev->add_flag("--intersections", pv->intersections, "paint faces in self-intersecting pairs (CGAL) red");
+  prev->add_flag("--penetration", pv->penetration,
+                 "paint faces with a corner more than 5 mm inside the body magenta, cyan where a second body part "
+                 "pinches it (the rule of `data check`), drawn through the body");
   std::vector<std::string> view_names;
   for (const View& v : kViews) view_names.push_back(v.name);
   prev->add_option("--view", pv->view, "camera on the body's front, back, left, right or top")

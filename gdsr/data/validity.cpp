@@ -66,34 +66,44 @@ void measure_intersections(const std::vector<Points3>& frames, const Faces& F, i
   r.si_median_pairs = median(pairs);
 }
 
+// Garment vertex i's depth under the body surface (metres, 0 when outside) and whether the
+// surface of a second body part is within reach of it (validity.hpp). cp: the body's closest
+// points to the garment vertices X; body_rest: the body in the first frame, where body parts
+// are told apart.
+struct VertexDepth {
+  double depth = 0;
+  bool pinched = false;
+};
+VertexDepth vertex_depth(const BodyQuery& body, const ClosestPoints& cp, const Points3& body_rest, const Points3& X,
+                         long i, const ValidityOptions& opt) {
+  if (cp.face(i) < 0 || !(cp.sdist(i) < 0)) return {};
+  const Faces& F = body.mesh().F;
+  const double sep2 = opt.pinch_separation * opt.pinch_separation;
+  const int f = cp.face(i);
+  const Vec3 rest = cp.bary(i, 0) * body_rest.row(F(f, 0)) + cp.bary(i, 1) * body_rest.row(F(f, 1)) +
+                    cp.bary(i, 2) * body_rest.row(F(f, 2));
+  auto other_part = [&](int g) {  // every corner of g was farther than pinch_separation at rest
+    for (int k = 0; k < 3; ++k)
+      if ((body_rest.row(F(g, k)) - rest.transpose()).squaredNorm() <= sep2) return false;
+    return true;
+  };
+  return {-cp.sdist(i), body.any_face_within(X.row(i).transpose(), opt.pinch_reach, other_part)};
+}
+
 struct Depths {
   double all = 0, free = 0, pinched = 0;  // deepest vertex under the body surface, metres (0 if none)
 };
 
-// Deepest garment vertex under the body surface, overall and split by pinch (validity.hpp).
-// cp: the body's closest points to the garment vertices X; body_rest: the body in the first
-// frame, where body parts are told apart.
+// Deepest garment vertex under the body surface, overall and split by pinch.
 Depths penetration(const BodyQuery& body, const ClosestPoints& cp, const Points3& body_rest, const Points3& X,
                    const ValidityOptions& opt) {
-  const Faces& F = body.mesh().F;
-  const double sep2 = opt.pinch_separation * opt.pinch_separation;
   Depths d;
   for (long i = 0; i < X.rows(); ++i) {
-    if (cp.face(i) < 0 || !(cp.sdist(i) < 0)) continue;
-    const double depth = -cp.sdist(i);
-    d.all = std::max(d.all, depth);
-    const int f = cp.face(i);
-    const Vec3 rest = cp.bary(i, 0) * body_rest.row(F(f, 0)) + cp.bary(i, 1) * body_rest.row(F(f, 1)) +
-                      cp.bary(i, 2) * body_rest.row(F(f, 2));
-    auto other_part = [&](int g) {  // every corner of g was farther than pinch_separation at rest
-      for (int k = 0; k < 3; ++k)
-        if ((body_rest.row(F(g, k)) - rest.transpose()).squaredNorm() <= sep2) return false;
-      return true;
-    };
-    if (body.any_face_within(X.row(i).transpose(), opt.pinch_reach, other_part))
-      d.pinched = std::max(d.pinched, depth);
-    else
-      d.free = std::max(d.free, depth);
+    const VertexDepth v = vertex_depth(body, cp, body_rest, X, i, opt);
+    if (!(v.depth > 0)) continue;
+    d.all = std::max(d.all, v.depth);
+    double& deepest = v.pinched ? d.pinched : d.free;
+    deepest = std::max(deepest, v.depth);
   }
   return d;
 }
@@ -286,6 +296,23 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
   measure_intersections(d.hr_frames, d.hr.F, opt.intersection_stride, v.hr, v.per_frame, &FrameValidity::hr_pairs);
   if (progress) progress(steps, steps);
   return v;
+}
+
+BodyDepths body_depths(const Dataset& d, int t, const Points3& X, const ValidityOptions& opt) {
+  if (!d.has_body()) fail("validity", "the dataset has no body");
+  if (t < 0 || t >= static_cast<int>(d.body_frames.size()))
+    fail("validity", "frame " + std::to_string(t) + " out of range");
+  const BodyQuery body(TriMesh{d.body_frames[t], d.body_faces});
+  const ClosestPoints cp = body.closest(X, /*smooth_normals=*/false);
+  BodyDepths out;
+  out.depth.resize(X.rows());
+  out.pinched.resize(X.rows());
+  for (long i = 0; i < X.rows(); ++i) {
+    const VertexDepth v = vertex_depth(body, cp, d.body_frames[0], X, i, opt);
+    out.depth[i] = v.depth;
+    out.pinched[i] = v.pinched;
+  }
+  return out;
 }
 
 // ---------------------------------------------------------------- manifest JSON

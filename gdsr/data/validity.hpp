@@ -131,6 +131,15 @@ struct ValidityFigures {
 // dataset without frames or a stride < 1. progress(done, total) counts frames.
 ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt = {}, const ProgressFn& progress = {});
 
+// Each garment vertex's depth under the body surface in frame t, by the rule of the body
+// figures above: X is that frame's LR or HR positions (N x 3, metres). Throws gdsr::Error when
+// the dataset has no body or t is out of range.
+struct BodyDepths {
+  std::vector<double> depth;  // N, metres, 0 where the vertex is outside the body
+  std::vector<char> pinched;  // N, 1 where a second body part is within pinch_reach (only where depth > 0)
+};
+BodyDepths body_depths(const Dataset& d, int t, const Points3& X, const ValidityOptions& opt = {});
+
 // The per-frame figures as CSV text: a header, then one line per frame (frame, LR and HR
 // intersecting pairs with -1 for unchecked frames, LR and HR depth outside pinches in mm,
 // agreement in mm, LR and HR threaded edges).

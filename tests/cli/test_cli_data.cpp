@@ -7,6 +7,7 @@
 #include "tests/support/data_fixtures.hpp"
 
 #include <doctest/doctest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "gdsr/sim/cloth_solver.hpp"
 
@@ -15,7 +16,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
 #include <sys/wait.h>
+#include <utility>
 
 using gdsr_test::check_one_line_error;
 using gdsr_test::gdsr_run;
@@ -156,6 +159,78 @@ TEST_CASE("cli data: make a tiny dataset, check it and preview a frame") {
                                          (dir / "x") + "'"),
                        "none.bvh");
   check_one_line_error(gdsr_run(dir, "data make --garment no_such_garment --out '" + (dir / "x") + "'"), "garment");
+}
+
+TEST_CASE("cli data: preview --penetration paints and counts the faces in the body") {
+  // The validity tests' sheet over a box body whose top rises 1, 8, 8, 3 mm through it: LR
+  // vertex (0.165, 0.15, 0) and the six HR ones over the box top are that deep (HR 2 mm less).
+  // In frame 2 a second box hovers 1 cm above them: pinched.
+  TempDir dir("cli_preview_depth");
+  gdsr::Dataset d = gdsr_test::stretched_dataset({0.001, 0.008, 0.008, 0.003});
+  gdsr_test::add_second_part(d, gdsr_test::box(0.6, 0.65, 0.13, 0.17, 0.01, 0.05),
+                             gdsr_test::box(0.14, 0.19, 0.13, 0.17, 0.01, 0.05));
+  gdsr::write_dataset(dir / "ds", d);
+  // Expected, from the geometry alone: faces with a corner over the box top, deeper than 5 mm.
+  auto faces_over_box = [](const gdsr::GarmentMesh& g, const gdsr::Points3& X, double depth) {
+    int n = 0;
+    for (int f = 0; f < g.F.rows(); ++f) {
+      bool in = false;
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::RowVector3d x = X.row(g.F(f, k));
+        in |= x.x() > 0.1 && x.x() < 0.2 && x.y() > 0.1 && x.y() < 0.2 && depth - x.z() > 0.005;
+      }
+      n += in;
+    }
+    return n;
+  };
+  const int lr_faces = faces_over_box(d.lr, d.lr_frames[1], 0.008),
+            hr_faces = faces_over_box(d.hr, d.hr_frames[1], 0.008);
+  REQUIRE(lr_faces > 0);
+  REQUIRE(hr_faces > lr_faces);
+  // Pixels of a colour: magenta (in the body) and cyan (pinched), BGR with shading and blending.
+  auto pixels = [](const std::string& png, bool magenta) {
+    const cv::Mat img = cv::imread(png, cv::IMREAD_COLOR);
+    REQUIRE_FALSE(img.empty());
+    int n = 0;
+    for (int y = 0; y < img.rows; ++y)
+      for (int x = 0; x < img.cols; ++x) {
+        const cv::Vec3b c = img.at<cv::Vec3b>(y, x);
+        n += magenta ? c[2] > 140 && c[0] > 140 && c[1] < 110 : c[2] < 90 && c[1] > 120 && c[0] > 150;
+      }
+    return n;
+  };
+  auto preview = [&](int frame) {
+    const std::string png = dir / ("f" + std::to_string(frame) + ".png");
+    const Run r = gdsr_run(dir, "data preview --data '" + (dir / "ds") + "' --frame " + std::to_string(frame) +
+                                    " --penetration --size 160 --out '" + png + "'");
+    CHECK(r.status == 0);
+    return std::make_pair(r.out, png);
+  };
+  const auto [out0, png0] = preview(0);  // 1 mm: under the limit
+  CHECK(out0.find("LR: 0 faces with a corner > 5 mm in the body outside pinches (deepest 0.0 mm), 0 pinched") !=
+        std::string::npos);
+  CHECK(pixels(png0, true) == 0);
+  CHECK(pixels(png0, false) == 0);
+  const auto [out1, png1] = preview(1);  // 8 mm (HR 6 mm), nothing above: outside pinches
+  CHECK(out1.find("LR: " + std::to_string(lr_faces) + " faces with a corner > 5 mm in the body outside pinches " +
+                  "(deepest 8.0 mm), 0 pinched") != std::string::npos);
+  CHECK(out1.find("HR: " + std::to_string(hr_faces) + " faces with a corner > 5 mm in the body outside pinches " +
+                  "(deepest 6.0 mm), 0 pinched") != std::string::npos);
+  CHECK(pixels(png1, true) > 0);  // drawn through the box that hides them from the front
+  CHECK(pixels(png1, false) == 0);
+  const auto [out2, png2] = preview(2);  // the same depths under the second box: pinched
+  CHECK(out2.find("LR: 0 faces with a corner > 5 mm in the body outside pinches (deepest 0.0 mm), " +
+                  std::to_string(lr_faces) + " pinched") != std::string::npos);
+  CHECK(pixels(png2, true) == 0);
+  CHECK(pixels(png2, false) > 0);
+  if (out1.find("LR: ") == std::string::npos) MESSAGE("stdout: " << out1);
+  // A dataset without a body: one line naming the flag, no picture.
+  gdsr::Dataset bodiless = gdsr_test::wave_dataset(2);
+  gdsr::write_dataset(dir / "nobody", bodiless);
+  check_one_line_error(
+      gdsr_run(dir, "data preview --data '" + (dir / "nobody") + "' --penetration --out '" + (dir / "nb.png") + "'"),
+      "--penetration");
+  CHECK_FALSE(fs::exists(dir / "nb.png"));
 }
 
 TEST_CASE("cli data: make warns when a skeleton's hips and shoulders are not recognised") {

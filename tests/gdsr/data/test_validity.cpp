@@ -18,66 +18,11 @@
 
 using gdsr::Points3;
 
-namespace {
-
-// A closed, outward-oriented box [x0,x1] x [y0,y1] x [z0,z1]: 8 vertices, 12 triangles.
-gdsr::TriMesh box(double x0, double x1, double y0, double y1, double z0, double z1) {
-  gdsr::TriMesh m;
-  m.V.resize(8, 3);
-  for (int i = 0; i < 8; ++i) m.V.row(i) << (i & 1 ? x1 : x0), (i & 2 ? y1 : y0), (i & 4 ? z1 : z0);
-  m.F.resize(12, 3);
-  m.F << 0, 2, 1, 1, 2, 3,  // z0 (normal -z)
-      4, 5, 6, 5, 7, 6,     // z1 (+z)
-      0, 1, 4, 1, 5, 4,     // y0 (-y)
-      2, 6, 3, 3, 6, 7,     // y1 (+y)
-      0, 4, 2, 2, 4, 6,     // x0 (-x)
-      1, 3, 5, 3, 7, 5;     // x1 (+x)
-  return m;
-}
-
-// LR 4x4 and HR 8x8 quads over 0.3 m x 0.3 m, every frame stretched by 1.1 along x, HR 2 mm
-// above LR; a box body whose top rises to z = top[t].
-gdsr::Dataset stretched_dataset(const std::vector<double>& top) {
-  gdsr::Dataset d;
-  d.lr = gdsr_test::grid_garment(gdsr_test::GridSpec(4, 4, 0.3, 0.3));
-  d.hr = gdsr_test::grid_garment(gdsr_test::GridSpec(8, 8, 0.3, 0.3));
-  for (double z : top) {
-    Points3 lr = d.lr.V, hr = d.hr.V;
-    lr.col(0) *= 1.1;
-    hr.col(0) *= 1.1;
-    hr.col(2).array() += 0.002;
-    d.lr_frames.push_back(lr);
-    d.hr_frames.push_back(hr);
-    const gdsr::TriMesh b = box(0.1, 0.2, 0.1, 0.2, -0.05, z);
-    d.body_frames.push_back(b.V);
-    d.body_faces = b.F;
-  }
-  d.corr = gdsr::compute_correspondence(d.lr, d.hr);
-  d.raster = gdsr::rasterize_uv(d.hr.UV, d.hr.FUV, 64, 64, 2);
-  d.manifest.garment = "stretched";
-  gdsr::update_manifest_counts(d);
-  return d;
-}
-
-// Adds a second body box to d's box body: `far` in every frame but `frame`, `near` there.
-void add_second_part(gdsr::Dataset& d, const gdsr::TriMesh& far, const gdsr::TriMesh& near, size_t frame = 2) {
-  gdsr::Faces F(d.body_faces.rows() * 2, 3);
-  F << d.body_faces, (far.F.array() + 8).matrix();
-  d.body_faces = F;
-  for (size_t t = 0; t < d.body_frames.size(); ++t) {
-    Points3 V(16, 3);
-    V << d.body_frames[t], (t == frame ? near : far).V;
-    d.body_frames[t] = V;
-  }
-}
-
-}  // namespace
-
 TEST_CASE("gdsr: validity figures of a stretched, lifted sheet over a rising box are the closed-form ones") {
   // Box top per frame; LR vertex (0.165, 0.15, 0) is inside with depth = top, HR's (at z =
   // 2 mm) with depth top - 2 mm; no vertex is nearer a side of the box than to its top.
   const std::vector<double> top = {0.001, 0.004, 0.008, 0.003};
-  const gdsr::Dataset d = stretched_dataset(top);
+  const gdsr::Dataset d = gdsr_test::stretched_dataset(top);
   gdsr::ValidityOptions opt;
   opt.penetration_limit = 0.0035;
   const gdsr::ValidityFigures v = gdsr::measure_validity(d, opt);
@@ -138,7 +83,7 @@ TEST_CASE("gdsr: validity figures of a stretched, lifted sheet over a rising box
 }
 
 TEST_CASE("gdsr: validity splits the agreement by scale: a ripple that vanishes on the LR vertices is all wrinkles") {
-  gdsr::Dataset d = stretched_dataset({0.0, 0.0});
+  gdsr::Dataset d = gdsr_test::stretched_dataset({0.0, 0.0});
   // Flat HR (no lift) plus 3 mm times sin(pi x / 75 mm) of the rest x: zero on every LR vertex
   // (75 mm apart) and +-3 mm on the HR vertices between them, so downsampling sees none of it.
   for (auto& hr : d.hr_frames)
@@ -155,9 +100,10 @@ TEST_CASE("gdsr: validity counts penetration under a second body part as a pinch
   // HR): cloth between two parts cannot be outside both, so frame 2 is a pinch frame and the
   // figures outside pinches come from frames 1 and 3.
   const std::vector<double> top = {0.001, 0.004, 0.008, 0.003};
-  gdsr::Dataset d = stretched_dataset(top);
-  const gdsr::TriMesh far = box(0.6, 0.65, 0.13, 0.17, 0.01, 0.05), near = box(0.14, 0.19, 0.13, 0.17, 0.01, 0.05);
-  add_second_part(d, far, near);
+  gdsr::Dataset d = gdsr_test::stretched_dataset(top);
+  const gdsr::TriMesh far = gdsr_test::box(0.6, 0.65, 0.13, 0.17, 0.01, 0.05),
+                      near = gdsr_test::box(0.14, 0.19, 0.13, 0.17, 0.01, 0.05);
+  gdsr_test::add_second_part(d, far, near);
   gdsr::ValidityOptions opt;
   opt.penetration_limit = 0.0035;
   const gdsr::ValidityFigures v = gdsr::measure_validity(d, opt);
@@ -185,14 +131,52 @@ TEST_CASE("gdsr: validity counts penetration under a second body part as a pinch
   CHECK_THROWS_AS(gdsr::measure_validity(d, opt), gdsr::Error);
 }
 
+TEST_CASE("gdsr: body_depths gives each vertex its depth in the body and whether a second part pinches it") {
+  // The pinch fixture above, per vertex: LR vertex (0.165, 0.15, 0) is the only one inside the
+  // box, as deep as the box top; in frame 2 the "hand" box hovers over it (pinched), in frame 1
+  // it is 0.5 m away (not).
+  const std::vector<double> top = {0.001, 0.004, 0.008, 0.003};
+  gdsr::Dataset d = gdsr_test::stretched_dataset(top);
+  gdsr_test::add_second_part(d, gdsr_test::box(0.6, 0.65, 0.13, 0.17, 0.01, 0.05),
+                             gdsr_test::box(0.14, 0.19, 0.13, 0.17, 0.01, 0.05));
+  for (int t : {1, 2}) {
+    CAPTURE(t);
+    const Points3& X = d.lr_frames[t];
+    const gdsr::BodyDepths bd = gdsr::body_depths(d, t, X);
+    REQUIRE(bd.depth.size() == static_cast<size_t>(X.rows()));
+    REQUIRE(bd.pinched.size() == static_cast<size_t>(X.rows()));
+    for (long i = 0; i < X.rows(); ++i) {
+      const bool inside = X(i, 0) > 0.1 && X(i, 0) < 0.2 && X(i, 1) > 0.1 && X(i, 1) < 0.2;
+      CAPTURE(i);
+      CHECK(bd.depth[i] == doctest::Approx(inside ? top[t] : 0.0).epsilon(1e-9));
+      CHECK(bd.pinched[i] == (inside && t == 2));
+    }
+  }
+  // HR is 2 mm higher: 2 mm and 6 mm deep in frames 1 and 2.
+  const gdsr::BodyDepths hr = gdsr::body_depths(d, 2, d.hr_frames[2]);
+  CHECK(*std::max_element(hr.depth.begin(), hr.depth.end()) == doctest::Approx(0.006).epsilon(1e-9));
+  // The reach is an option, as for the figures: 5 mm does not get to the hand 1 cm up.
+  gdsr::ValidityOptions opt;
+  opt.pinch_reach = 0.005;
+  const gdsr::BodyDepths narrow = gdsr::body_depths(d, 2, d.lr_frames[2], opt);
+  CHECK(std::count(narrow.pinched.begin(), narrow.pinched.end(), 1) == 0);
+  CHECK_THROWS_AS(gdsr::body_depths(d, 4, d.lr_frames[0]), gdsr::Error);
+  CHECK_THROWS_AS(gdsr::body_depths(d, -1, d.lr_frames[0]), gdsr::Error);
+  gdsr::Dataset bodiless = gdsr_test::stretched_dataset(top);
+  bodiless.body_frames.clear();
+  bodiless.body_faces.resize(0, 3);
+  CHECK_THROWS_AS(gdsr::body_depths(bodiless, 0, bodiless.lr_frames[0]), gdsr::Error);
+}
+
 TEST_CASE("gdsr: validity finds a pinching part by its surface, not its vertices") {
   // As above, but the second part is a broad plate (a hip under a resting hand): 0.6 m square,
   // 1 cm above the sheet in frame 2, its corners 0.3 m or more from the deepest vertex, beyond
   // the 4 cm reach. Its surface is within reach, so frame 2 is a pinch frame all the same.
   const std::vector<double> top = {0.001, 0.004, 0.008, 0.003};
-  gdsr::Dataset d = stretched_dataset(top);
-  const gdsr::TriMesh far = box(1.0, 1.6, -0.15, 0.45, 0.01, 0.05), near = box(-0.15, 0.45, -0.15, 0.45, 0.01, 0.05);
-  add_second_part(d, far, near);
+  gdsr::Dataset d = gdsr_test::stretched_dataset(top);
+  const gdsr::TriMesh far = gdsr_test::box(1.0, 1.6, -0.15, 0.45, 0.01, 0.05),
+                      near = gdsr_test::box(-0.15, 0.45, -0.15, 0.45, 0.01, 0.05);
+  gdsr_test::add_second_part(d, far, near);
   // The yardstick's premise: no vertex of the plate is within reach of the sheet's deepest point.
   const double nearest_corner = (near.V.rowwise() - Eigen::RowVector3d(0.165, 0.15, 0)).rowwise().norm().minCoeff();
   REQUIRE(nearest_corner > 0.2);
@@ -216,11 +200,11 @@ TEST_CASE("gdsr: validity counts the frames where the body crosses itself, and t
   // "arm" that in frame 3 is pushed 1 cm into the body box's side below the sheet (the body
   // crosses itself; the LR vertex 3 mm deep there is pinched by it).
   const std::vector<double> top = {0.001, 0.004, 0.008, 0.003};
-  gdsr::Dataset d = stretched_dataset(top);
-  const gdsr::TriMesh hand_far = box(0.6, 0.65, 0.13, 0.17, 0.01, 0.05),
-                      hand_near = box(0.14, 0.19, 0.13, 0.17, 0.01, 0.05),
-                      arm_far = box(0.7, 0.8, 0.13, 0.17, -0.03, -0.005),
-                      arm_in = box(0.19, 0.29, 0.13, 0.17, -0.03, -0.005);
+  gdsr::Dataset d = gdsr_test::stretched_dataset(top);
+  const gdsr::TriMesh hand_far = gdsr_test::box(0.6, 0.65, 0.13, 0.17, 0.01, 0.05),
+                      hand_near = gdsr_test::box(0.14, 0.19, 0.13, 0.17, 0.01, 0.05),
+                      arm_far = gdsr_test::box(0.7, 0.8, 0.13, 0.17, -0.03, -0.005),
+                      arm_in = gdsr_test::box(0.19, 0.29, 0.13, 0.17, -0.03, -0.005);
   gdsr::Faces F(36, 3);
   F << d.body_faces, (hand_far.F.array() + 8).matrix(), (arm_far.F.array() + 16).matrix();
   d.body_faces = F;
@@ -334,7 +318,7 @@ TEST_CASE("gdsr: validity counts the frames where a vertex is dragged out of the
   // Frame 2 of the HR pulls one inner vertex 0.15 m out of the sheet (HR edges 0.0375 m in the
   // pattern, stretched 1.1x along u): its edges along u become sqrt(0.04125^2 + 0.15^2) long,
   // 4.15x their pattern length.
-  gdsr::Dataset d = stretched_dataset({0.001, 0.001, 0.001, 0.001});
+  gdsr::Dataset d = gdsr_test::stretched_dataset({0.001, 0.001, 0.001, 0.001});
   const int inner = 4 * 9 + 4;  // (4, 4) of the 9 x 9 HR grid vertices
   REQUIRE(std::abs(d.hr.V(inner, 0) - 0.15) < 1e-9);
   REQUIRE(std::abs(d.hr.V(inner, 1) - 0.15) < 1e-9);
@@ -381,10 +365,11 @@ TEST_CASE("gdsr: validity counts the frames where cloth is threaded on a body pa
   // two vertices of the row y = 0.075 (LR x = 0, 0.0825; HR x = 0.04125, 0.0825): the edge
   // between them has both ends outside and its middle 1 cm deep inside (the box's half-width
   // in y). In the other frames the forearm is 0.5 m away.
-  gdsr::Dataset d = stretched_dataset({-0.01, -0.01, -0.01});
+  gdsr::Dataset d = gdsr_test::stretched_dataset({-0.01, -0.01, -0.01});
   auto with_forearm = [&](double x0, double x1) {
     gdsr::Dataset e = d;
-    add_second_part(e, box(0.6, 0.65, 0.065, 0.085, -0.02, 0.02), box(x0, x1, 0.065, 0.085, -0.02, 0.02), 1);
+    gdsr_test::add_second_part(e, gdsr_test::box(0.6, 0.65, 0.065, 0.085, -0.02, 0.02),
+                               gdsr_test::box(x0, x1, 0.065, 0.085, -0.02, 0.02), 1);
     return e;
   };
   const gdsr::Dataset threaded = with_forearm(0.05, 0.075);
