@@ -194,7 +194,21 @@ namespace sim {
 //     self-intersections 100 / 99.3 -> 100 / 100%; LR frames > 5 mm inside the body outside
 //     pinches 7 / 18 -> 7 / 41 (at 0.3 the LR is byte-identical: its interval never shortened;
 //     at 0.30001 the chaotic spread). skirt_short on CMU 01_01 (1-6 s, the demo's): byte-identical.
-inline constexpr int kSolverRevision = 27;
+// 28: the t-shirt's sleeves end on the lower forearm, 10 cm (x height / 1.75) short of the wrist
+//     (garment_tshirt.cpp, kCuffAboveWrist). Down to the wrist, the sleeve slid onto the hand, and
+//     the cuff, caught by the hand's and the forearm's turns, was pulled into the forearm until the
+//     arm came out through the sleeve (`data preview --penetration` shows it). T-shirt at 30 mm,
+//     4 s from 2 s (from 1 s on 01_01 / 01_03), LR frames with cloth more than 5 mm inside the body
+//     outside pinches, friction 0.3 / 0.30001 / 0.29999 / 0.30002 on salsa 61_03: 103 / ~100 /
+//     95 / 113 -> 31 / 14 / 19 / 12 (5 cm short: 26 / 88 / 94 / 22; 15 cm: 36 / 22 / 36 / 17);
+//     at 0.3, 61_02 66 -> 17, 60_03 68 -> 57 (frames free of self-intersections 41 -> 100%),
+//     60_02 7 -> 14, 01_01 4 -> 5, 01_03 4 -> 7, walk 131_02 23 -> 24 (frames with cloth threaded
+//     on the body 59 -> 5). At 30 / 10 mm (friction 0.3): 61_03 LR / HR 103 / 99 -> 31 / 20 frames,
+//     HR frames with an edge > 2x its pattern 81 -> 2, 100% / 100% free of self-intersections
+//     before and after; 60_02 7 / 11 -> 14 / 10, 100% / 100%. What is left on 61_03 is mostly the
+//     crook of a sharply bent elbow, where the skinned arm's two sides overlap. Other garments:
+//     byte-identical (pants on salsa 60_02, 0.3 s, LR and HR frames).
+inline constexpr int kSolverRevision = 28;
 
 struct SimParams {
   int substeps = 20;                // per body frame

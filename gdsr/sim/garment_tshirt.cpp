@@ -3,14 +3,13 @@
 // into a front and a back panel (side seams at the ellipse's sides); above the shoulder
 // line each panel folds horizontally inwards to the shoulder seam (the shoulder top is a
 // horizontal plane with an elliptic neck opening). Sleeves: a circular cone around each
-// arm's centre line from the torso to the wrist (radius rs at the shoulder joint, tapering to
-// a cuff kCuffEase over the wrist), one panel per sleeve (a sector of a ring) with its seam
-// under the arm. The armhole is the exact intersection curve of sleeve cone and torso
-// cylinder, so both developments are isometric and the sleeve cap sews edge by edge to the
-// armhole of the front and back panels. Only the shoulder fold is not isometric (shear where
-// the ellipse turns sideways). No pins: it hangs on the shoulders. Cut for an A-pose rest
-// (sim::rest_arm_drop_degrees): cut for a T-pose, the sleeves were short over the top of the
-// arm once the arms came down and dragged the shoulders off a salsa dancer.
+// arm's centre line from the torso to the forearm (radius rs at the shoulder joint, tapering
+// to a cuff kCuffEase over the wrist's radius, kCuffAboveWrist up from the wrist), one panel
+// per sleeve (a sector of a ring) with its seam under the arm. The armhole is the exact intersection curve of sleeve
+// cone and torso cylinder, so both developments are isometric and the sleeve cap sews edge by edge to the armhole of
+// the front and back panels. Only the shoulder fold is not isometric (shear where the ellipse turns sideways). No pins:
+// it hangs on the shoulders. Cut for an A-pose rest (sim::rest_arm_drop_degrees): cut for a T-pose, the sleeves were
+// short over the top of the arm once the arms came down and dragged the shoulders off a salsa dancer.
 #include "gdsr/error.hpp"
 #include "gdsr/sim/garment_design.hpp"
 
@@ -32,10 +31,15 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr int kHole = 10;           // armhole edges per torso panel (a sleeve cap has 2 kHole)
 constexpr int kCuff = 8;            // edges of the cuff (an arc of the sleeve's flat ring)
 constexpr double kCuffEase = 0.03;  // metres (x height / 1.75) of the cuff's radius over the wrist's
+// Metres (x height / 1.75) from the cuff up to the wrist: the sleeve ends on the lower forearm.
+// Down to the wrist, it slid onto the hand and bunched over it, and the cuff, caught by the hand
+// and the forearm's turns, was pulled into the forearm and the arm came out of the sleeve (solver
+// revision 28 has the figures).
+constexpr double kCuffAboveWrist = 0.10;
 
 struct Sleeve {
   Vec3 root, d, e1, e2;                       // centre line and frame: e1 down (perpendicular to d), e2 = e1 x d
-  double rs = 0, slope = 0, t_wrist = 0;      // radius rs + slope t at distance t along d (slope <= 0)
+  double rs = 0, slope = 0, t_cuff = 0;       // radius rs + slope t at distance t along d (slope <= 0)
   std::array<double, 2 * kHole + 1> theta{};  // theta[0]: bottom side-seam crossing, theta[kHole]: top
   Vec3 normal(double th) const { return std::cos(th) * e1 + std::sin(th) * e2; }
   Vec3 at(double t, double th) const { return root + t * d + (rs + slope * t) * normal(th); }
@@ -144,8 +148,8 @@ GarmentDesign design_tshirt(const BodyLandmarks& lm) {
     q.root = lm.arm_root[k];
     q.d = lm.arm_dir[k];
     q.rs = rs;
-    q.t_wrist = lm.arm_len[k];
-    q.slope = (rw - rs) / q.t_wrist;
+    q.t_cuff = lm.arm_len[k] - kCuffAboveWrist * s;
+    q.slope = (rw - rs) / q.t_cuff;
     q.e1 = (-Vec3::UnitY() + q.d * q.d.y()).normalized();
     q.e2 = q.e1.cross(q.d);
   }
@@ -192,7 +196,7 @@ GarmentDesign design_tshirt(const BodyLandmarks& lm) {
       y_hole_top = std::max(y_hole_top, q.at(t, q.theta[j]).y());
       y_hole_bot = std::min(y_hole_bot, q.at(t, q.theta[j]).y());
     }
-    if (q.t_wrist < t_max + 0.15 * s) gdsr::fail("sim/garment_tshirt", "arm too short for a sleeve");
+    if (q.t_cuff < t_max + 0.15 * s) gdsr::fail("sim/garment_tshirt", "arm too short for a sleeve");
   }
   const double y_top = std::max(lm.shoulder_top_y, y_hole_top + 0.01 * s) + 0.02 * s;
   T.Hsh = y_top - T.hem_y;
@@ -266,7 +270,7 @@ GarmentDesign design_tshirt(const BodyLandmarks& lm) {
   for (int k = 0; k < 2; ++k) {
     const Sleeve& q = T.sl[k];
     std::vector<Vec2> o{q.flat(T.hit(q, q.theta[0]), 0)};
-    for (int j = 0; j <= kCuff; ++j) o.push_back(q.flat(q.t_wrist, 2 * kPi * j / kCuff));
+    for (int j = 0; j <= kCuff; ++j) o.push_back(q.flat(q.t_cuff, 2 * kPi * j / kCuff));
     for (int j = 2 * kHole; j >= 1; --j) o.push_back(q.flat(T.hit(q, q.theta[j]), q.theta[j] - q.theta[0]));
     double xmin = 1e300;
     for (const auto& v : o) xmin = std::min(xmin, v.x());

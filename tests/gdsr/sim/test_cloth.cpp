@@ -521,8 +521,9 @@ namespace {
 // Frames of the 30 mm t-shirt on CMU 131_01 from 2 s for 1 s (46 frames with the rest blend) with
 // an edge longer than twice its pattern length: cloth threaded on a forearm, stretched between
 // its two sides. The arms drop from the A-pose onto the hips from frame 10. (Pushed out at once:
-// 28 frames until revision 26 centred the shirt on the trunk, 5 at 26, 11 since revision 27's
-// self-contact detection; 131_03 from 3 s, used at 26 with 20 frames, gives 0 at 27.)
+// 28 frames until revision 26 centred the shirt on the trunk, 5 at 26, 11 at revision 27's
+// self-contact detection, 9 since revision 28's shorter sleeves; 131_03 from 3 s, used at 26
+// with 20 frames, gives 0 at 27.)
 int tshirt_walk_torn_frames(double max_push_step) {
   sim::SimParams p;
   p.max_push_step = max_push_step;
@@ -544,7 +545,7 @@ TEST_CASE("cloth: a forearm dropping onto the hip does not thread the t-shirt") 
   CHECK(capped <= 2);
   const int at_once = tshirt_walk_torn_frames(1e9);  // the test can fail: revision 14's push
   MESSAGE("... pushed out at once: " << at_once << " of 46");
-  CHECK(at_once >= 10);
+  CHECK(at_once >= 5);
 }
 
 namespace {
@@ -597,7 +598,7 @@ TEST_CASE("cloth: a t-shirt stays on a salsa dancer's shoulders and arms") {
   // down, so they pulled the shoulders down off the body: on 60_02 (2-3 s, 30 mm) one sleeve
   // slid 30 cm down its arm, and in 36 of 46 frames a shoulder top was more than 5 cm from
   // the nearest cloth (26 with tapered sleeves alone; a one-off script with these
-  // definitions). Cut for an A-pose with tapered sleeves: every wrist within 4-6 cm of its
+  // definitions). Cut for an A-pose with tapered sleeves: every forearm within 4-6 cm of its
   // sleeve, and 0-12 such frames over small changes of the setup (the arms reach forward and
   // pull the back of the loose shirt off the shoulder blades for a moment).
   const GarmentRun run = tshirt_on_salsa("60_02");
@@ -614,11 +615,12 @@ TEST_CASE("cloth: a t-shirt stays on a salsa dancer's shoulders and arms") {
       shoulder.push_back(v);
   }
   REQUIRE(shoulder.size() >= 6);
-  // Each wrist (body vertices within 4 cm of its landmark) and the cloth of its sleeve's
-  // outer half once settled.
+  // Each forearm under its cuff (body vertices within 4 cm of the arm's axis there; the sleeves
+  // end 10 cm x height / 1.75 short of the wrist) and the cloth of its sleeve's outer half once
+  // settled.
   std::vector<int> sleeve[2], wrist[2];
   for (int k = 0; k < 2; ++k) {
-    const Vec3 w = lm.arm_root[k] + lm.arm_len[k] * lm.arm_dir[k];
+    const Vec3 w = lm.arm_root[k] + (lm.arm_len[k] - 0.10 * lm.height / 1.75) * lm.arm_dir[k];
     for (int v = 0; v < B0.rows(); ++v)
       if ((Vec3(B0.row(v)) - w).norm() < 0.04) wrist[k].push_back(v);
     for (int v = 0; v < out[0].rows(); ++v) {
@@ -634,7 +636,7 @@ TEST_CASE("cloth: a t-shirt stays on a salsa dancer's shoulders and arms") {
     for (int v : idx) m += Vec3(X.row(v));
     return Vec3(m / static_cast<double>(idx.size()));
   };
-  double out_of_sleeve = 0;  // largest distance from a wrist's centre to its sleeve's nearest vertex
+  double out_of_sleeve = 0;  // largest distance from a forearm's centre to its sleeve's nearest vertex
   int bare = 0;
   for (size_t t = 0; t < out.size(); ++t) {
     REQUIRE(out[t].allFinite());
@@ -652,8 +654,8 @@ TEST_CASE("cloth: a t-shirt stays on a salsa dancer's shoulders and arms") {
     }
     bare += gap > 0.05;
   }
-  MESSAGE("farthest wrist from its sleeve: " << out_of_sleeve << " m; frames with a shoulder top > 5 cm from cloth: "
-                                             << bare << " of " << out.size());
+  MESSAGE("farthest forearm from its sleeve: " << out_of_sleeve << " m; frames with a shoulder top > 5 cm from cloth: "
+                                               << bare << " of " << out.size());
   CHECK(out_of_sleeve < 0.1);
   CHECK(bare <= 18);
 }
