@@ -1,15 +1,16 @@
-// Long-sleeve t-shirt for a rest pose with the arms clear of the trunk (T- or A-pose).
-// Torso: an elliptic cylinder (semi-axes A sideways, B front-back) around the trunk, cut
-// into a front and a back panel (side seams at the ellipse's sides); above the shoulder
-// line each panel folds horizontally inwards to the shoulder seam (the shoulder top is a
-// horizontal plane with an elliptic neck opening). Sleeves: a circular cone around each
-// arm's centre line from the torso to the forearm (radius rs at the shoulder joint, tapering
-// to a cuff kCuffEase over the wrist's radius, kCuffAboveWrist up from the wrist), one panel
-// per sleeve (a sector of a ring) with its seam under the arm. The armhole is the exact intersection curve of sleeve
-// cone and torso cylinder, so both developments are isometric and the sleeve cap sews edge by edge to the armhole of
-// the front and back panels. Only the shoulder fold is not isometric (shear where the ellipse turns sideways). No pins:
-// it hangs on the shoulders. Cut for an A-pose rest (sim::rest_arm_drop_degrees): cut for a T-pose, the sleeves were
-// short over the top of the arm once the arms came down and dragged the shoulders off a salsa dancer.
+// Long-sleeve t-shirt for a rest pose with the arms clear of the trunk (T- or A-pose). Torso:
+// an elliptic cylinder (semi-axes A sideways, B front-back) around the trunk, cut into a front
+// and a back panel (side seams at the ellipse's sides); above the shoulder line each panel
+// folds horizontally inwards to the shoulder seam (the shoulder top is a horizontal plane with
+// an elliptic neck opening). Sleeves: a circular cone around each arm's centre line from the
+// torso to the forearm (radius rs at the shoulder joint, tapering to a cuff kCuffEase over the
+// wrist's radius, kCuffAboveWrist up from the wrist), one panel per sleeve (a sector of a ring)
+// with its seam under the arm. The armhole is the exact intersection curve of sleeve cone and
+// torso cylinder, so both developments are isometric and the sleeve cap sews edge by edge to
+// the armhole of the front and back panels. Only the shoulder fold is not isometric (shear
+// where the ellipse turns sideways). No pins: it hangs on the shoulders. Cut for an A-pose rest
+// (sim::rest_arm_drop_degrees): cut for a T-pose, the sleeves were short over the top of the
+// arm once the arms came down and dragged the shoulders off a salsa dancer.
 #include "gdsr/error.hpp"
 #include "gdsr/sim/garment_design.hpp"
 

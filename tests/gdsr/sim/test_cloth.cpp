@@ -618,17 +618,17 @@ TEST_CASE("cloth: a t-shirt stays on a salsa dancer's shoulders and arms") {
   // Each forearm under its cuff (body vertices within 4 cm of the arm's axis there; the sleeves
   // end 10 cm x height / 1.75 short of the wrist) and the cloth of its sleeve's outer half once
   // settled.
-  std::vector<int> sleeve[2], wrist[2];
+  std::vector<int> sleeve[2], forearm[2];
   for (int k = 0; k < 2; ++k) {
     const Vec3 w = lm.arm_root[k] + (lm.arm_len[k] - 0.10 * lm.height / 1.75) * lm.arm_dir[k];
     for (int v = 0; v < B0.rows(); ++v)
-      if ((Vec3(B0.row(v)) - w).norm() < 0.04) wrist[k].push_back(v);
+      if ((Vec3(B0.row(v)) - w).norm() < 0.04) forearm[k].push_back(v);
     for (int v = 0; v < out[0].rows(); ++v) {
       const Vec3 x = Vec3(out[0].row(v)) - lm.arm_root[k];
       const double t = x.dot(lm.arm_dir[k]);
       if (t > 0.5 * lm.arm_len[k] && (x - t * lm.arm_dir[k]).norm() < 0.12) sleeve[k].push_back(v);
     }
-    REQUIRE(wrist[k].size() >= 4);
+    REQUIRE(forearm[k].size() >= 4);
     REQUIRE(sleeve[k].size() >= 10);
   }
   auto mean = [](const gdsr::Points3& X, const std::vector<int>& idx) {
@@ -641,7 +641,7 @@ TEST_CASE("cloth: a t-shirt stays on a salsa dancer's shoulders and arms") {
   for (size_t t = 0; t < out.size(); ++t) {
     REQUIRE(out[t].allFinite());
     for (int k = 0; k < 2; ++k) {
-      const Vec3 w = mean(body.frames[t], wrist[k]);
+      const Vec3 w = mean(body.frames[t], forearm[k]);
       double best = 1e9;
       for (int v : sleeve[k]) best = std::min(best, (Vec3(out[t].row(v)) - w).norm());
       out_of_sleeve = std::max(out_of_sleeve, best);
