@@ -617,6 +617,7 @@ struct CheckArgs {
   std::string per_frame;  // non-empty: write each frame's figures to this CSV
   int intersection_stride = kDefaultIntersectionStride;
   bool body = true;
+  double pinch_gap_mm = 1e3 * gdsr::ValidityOptions{}.pinch_gap;
 };
 
 // "same" if every number of `a` equals the one at the same place in `b` (relative 1e-9),
@@ -658,6 +659,7 @@ void run_check(const CheckArgs& a) {
     gdsr::ValidityOptions vo;
     vo.intersection_stride = a.intersection_stride;
     vo.body = a.body;
+    vo.pinch_gap = 1e-3 * a.pinch_gap_mm;
     double seconds = 0;
     const gdsr::ValidityFigures v = measure(d, vo, seconds);
     std::printf("%s", gdsr::validity_table(v).c_str());
@@ -673,6 +675,11 @@ void run_check(const CheckArgs& a) {
       if (stored.intersection_stride != v.intersection_stride || stored.body_measured != v.body_measured)
         std::printf("  manifest: validity figures stored with stride %d%s; not compared\n", stored.intersection_stride,
                     stored.body_measured ? " and the body" : " and no body");
+      else if (stored.body_measured && std::abs(stored.pinch_gap - v.pinch_gap) > 1e-9)
+        std::printf(
+            "  manifest: validity figures stored with a pinch gap of %.1f mm (0: before the crease rule); not "
+            "compared\n",
+            1e3 * stored.pinch_gap);
       else {
         // Over the stored keys: a manifest written before a figure existed still compares.
         const std::string diff = compare_json(m.validity, gdsr::validity_to_json(v));
@@ -838,7 +845,7 @@ void add_data_command(CLI::App& app) {
   prev->add_flag("--intersections", pv->intersections, "paint faces in self-intersecting pairs (CGAL) red");
   prev->add_flag("--penetration", pv->penetration,
                  "paint faces with a corner more than 5 mm inside the body magenta, cyan where a second body part "
-                 "pinches it (the rule of `data check`), drawn through the body");
+                 "or a closed crease pinches it (the rule of `data check`), drawn through the body");
   std::vector<std::string> view_names;
   for (const View& v : kViews) view_names.push_back(v.name);
   prev->add_option("--view", pv->view, "camera on the body's front, back, left, right or top")
@@ -872,6 +879,11 @@ void add_data_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   ch->add_flag("!--no-body", chk->body, "do not measure the body penetration");
+  ch->add_option("--pinch-gap", chk->pinch_gap_mm,
+                 "mm: cloth in a crease of one body part closed to less than this is pinched (0: off, as manifests "
+                 "measured before the crease rule)")
+      ->capture_default_str()
+      ->check(finite_range(0.0, 1000.0));
   ch->add_option("--per-frame", chk->per_frame,
                  "also write each frame's figures to this CSV (intersecting pairs, depth outside pinches, agreement)");
   ch->callback([chk]() { run_check(*chk); });

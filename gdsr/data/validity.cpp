@@ -66,10 +66,24 @@ void measure_intersections(const std::vector<Points3>& frames, const Faces& F, i
   r.si_median_pairs = median(pairs);
 }
 
-// Garment vertex i's depth under the body surface (metres, 0 when outside) and whether the
-// surface of a second body part is within reach of it (validity.hpp). cp: the body's closest
-// points to the garment vertices X; body_rest: the body in the first frame, where body parts
-// are told apart.
+// Whether the way out of the body for garment vertex i (inside it), from its closest body point
+// on along the direction from the vertex to that point, meets the body again within `gap`
+// metres: the cloth lies in a crease closed to less than that (a bent elbow's crook).
+bool in_closed_crease(const BodyQuery& body, const ClosestPoints& cp, const Points3& X, long i, double gap) {
+  constexpr double kStart = 1e-4;  // metres past the closest point: the ray must not hit its own face
+  if (!(gap > kStart)) return false;
+  const Vec3 out = cp.point.row(i) - X.row(i);
+  if (!(out.norm() > 1e-12)) return false;
+  Points3 origin(1, 3), dir(1, 3);
+  dir.row(0) = out.normalized().transpose();
+  origin.row(0) = cp.point.row(i) + kStart * dir.row(0);
+  return body.intersect(origin, dir, 0.0, gap - kStart).face(0) >= 0;
+}
+
+// Garment vertex i's depth under the body surface (metres, 0 when outside) and whether it is
+// pinched: the surface of a second body part within reach of it, or a closed crease of its own
+// part with less than pinch_gap of room (validity.hpp). cp: the body's closest points to the
+// garment vertices X; body_rest: the body in the first frame, where body parts are told apart.
 struct VertexDepth {
   double depth = 0;
   bool pinched = false;
@@ -87,7 +101,8 @@ VertexDepth vertex_depth(const BodyQuery& body, const ClosestPoints& cp, const P
       if ((body_rest.row(F(g, k)) - rest.transpose()).squaredNorm() <= sep2) return false;
     return true;
   };
-  return {-cp.sdist(i), body.any_face_within(X.row(i).transpose(), opt.pinch_reach, other_part)};
+  if (body.any_face_within(X.row(i).transpose(), opt.pinch_reach, other_part)) return {-cp.sdist(i), true};
+  return {-cp.sdist(i), in_closed_crease(body, cp, X, i, opt.pinch_gap)};
 }
 
 struct Depths {
@@ -210,6 +225,7 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
   if (opt.intersection_stride < 1) fail("validity", "intersection stride must be >= 1");
   if (!(opt.penetration_limit >= 0)) fail("validity", "penetration limit must be >= 0");
   if (!(opt.pinch_reach > 0) || !(opt.pinch_separation > 0)) fail("validity", "pinch reach and separation must be > 0");
+  if (!(opt.pinch_gap >= 0)) fail("validity", "pinch gap must be >= 0");
   if (!(opt.tear_stretch > 1)) fail("validity", "tear stretch must be > 1");
   if (!(opt.threaded_depth > 0)) fail("validity", "threaded depth must be > 0");
   const int T = static_cast<int>(d.lr_frames.size());
@@ -221,6 +237,7 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
   v.penetration_limit = opt.penetration_limit;
   v.tear_stretch = opt.tear_stretch;
   v.threaded_depth = opt.threaded_depth;
+  v.pinch_gap = opt.pinch_gap;
   v.lr.faces = static_cast<int>(d.lr.F.rows());
   v.hr.faces = static_cast<int>(d.hr.F.rows());
   v.body_measured = opt.body && d.has_body();
@@ -432,6 +449,7 @@ nlohmann::json validity_to_json(const ValidityFigures& v) {
                       {"penetration_limit_m", v.penetration_limit},
                       {"tear_stretch", v.tear_stretch},
                       {"threaded_depth_m", v.threaded_depth},
+                      {"pinch_gap_m", v.pinch_gap},
                       {"body_measured", v.body_measured},
                       {"lr", resolution_json(v.lr, v.body_measured)},
                       {"hr", resolution_json(v.hr, v.body_measured)},
@@ -454,6 +472,7 @@ ValidityFigures validity_from_json(const nlohmann::json& j) {
   v.penetration_limit = take<double>(j, "penetration_limit_m", "");
   if (j.contains("tear_stretch")) v.tear_stretch = take<double>(j, "tear_stretch", "");
   if (j.contains("threaded_depth_m")) v.threaded_depth = take<double>(j, "threaded_depth_m", "");
+  v.pinch_gap = j.contains("pinch_gap_m") ? take<double>(j, "pinch_gap_m", "") : 0.0;
   v.body_measured = take<bool>(j, "body_measured", "");
   v.body_crossing_frames = j.contains("body_crossing_frames") ? take<int>(j, "body_crossing_frames", "") : -1;
   v.lr = resolution_from_json(take<nlohmann::json>(j, "lr", ""), v.body_measured, "lr.");
@@ -543,7 +562,8 @@ std::string validity_table(const ValidityFigures& v) {
          depth_free(v.hr).c_str());
     line("  body: outside pinches: frames > %-7s %14d %14d\n", mm.c_str(), v.lr.frames_over_limit_free,
          v.hr.frames_over_limit_free);
-    line("  body: pinch frames (2nd part, > %-7s %14d %14d\n", (mm + ")").c_str(), v.lr.pinch_frames, v.hr.pinch_frames);
+    line("  body: pinch frames (part/crease > %-7s%14d %14d\n", (mm + ")").c_str(), v.lr.pinch_frames,
+         v.hr.pinch_frames);
     if (v.body_crossing_frames >= 0) {
       line("  %-40s %14d\n", "body: frames it crosses itself (2 parts)", v.body_crossing_frames);
       line("  %-40s %14d %14d\n", "  pinch frames among them", v.lr.pinch_frames_in_body_crossings,

@@ -14,7 +14,11 @@
 //     frame, from the closest point; Embree point query, exact distance): cloth between a hand
 //     and a hip cannot be outside both, so pinched frames are counted apart (the distance is
 //     to the surface, not to the part's vertices, which are 25 mm apart on average on the
-//     skinned bodies: there, a part whose surface was within reach could be missed);
+//     skinned bodies: there, a part whose surface was within reach could be missed); a
+//     penetrating vertex is also pinched in a closed crease of one part (the crook of a bent
+//     elbow, forearm and upper arm less than pinch_separation apart at rest): the ray from its
+//     closest body point, on along the way out (vertex to closest point), meets the body again
+//     within pinch_gap (Embree ray), less room than the cloth needs on both sides;
 //     and the body's own crossings: frames where two body faces intersect (CGAL) whose
 //     vertices were all farther than pinch_separation apart in the first frame (two parts:
 //     a mocap forearm passing into the trunk; the skin creasing at a bent joint does not
@@ -51,6 +55,8 @@ struct ValidityOptions {
   bool body = true;                  // false: skip the penetration even if the dataset has a body
   double pinch_reach = 0.04;         // metres: a second body part this close to a penetrating vertex pinches it
   double pinch_separation = 0.15;    // metres apart in the first frame: two points on different body parts
+  double pinch_gap = 0.008;          // metres: a crease of one part closed to less than this pinches the cloth in it
+                                     // (two cloth thicknesses of 4 mm, as the solver keeps off the body); 0: off
   double tear_stretch = 2;           // frames with an edge longer than this times its pattern length are counted
   double threaded_depth = 0.005;     // metres: an edge with both ends outside the body and its middle inside deeper
                                      // than this is threaded (a chord of cloth resting on a wrist dips ~2 mm)
@@ -105,6 +111,7 @@ struct ValidityFigures {
   double penetration_limit = 0.005;  // metres
   double tear_stretch = 2;           // see ValidityOptions
   double threaded_depth = 0.005;     // metres, see ValidityOptions
+  double pinch_gap = 0.008;          // metres, see ValidityOptions (0 in manifests measured before the crease rule)
   bool body_measured = false;
   int body_crossing_frames = 0;  // frames where two body parts intersect (see above; -1: not measured)
   ResolutionValidity lr, hr;
@@ -136,7 +143,8 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt = 
 // the dataset has no body or t is out of range.
 struct BodyDepths {
   std::vector<double> depth;  // N, metres, 0 where the vertex is outside the body
-  std::vector<char> pinched;  // N, 1 where a second body part is within pinch_reach (only where depth > 0)
+  std::vector<char> pinched;  // N, 1 where a second body part is within pinch_reach or a closed crease holds it
+                              // (only where depth > 0; see the header comment)
 };
 BodyDepths body_depths(const Dataset& d, int t, const Points3& X, const ValidityOptions& opt = {});
 

@@ -114,6 +114,12 @@ TEST_CASE("cli data: make a tiny dataset, check it and preview a frame") {
   CHECK(chk.out.find("strain: longest edge / pattern") != std::string::npos);
   CHECK(chk.out.find("stored validity figures agree with the recomputed ones") != std::string::npos);
   if (chk.out.find("agree with the") == std::string::npos) MESSAGE("stdout: " << chk.out);
+  // Another crease rule (here off) measures other figures: they are not compared with the stored ones.
+  const Run off = gdsr_run(dir, "data check --data '" + out + "' --pinch-gap 0");
+  CHECK(off.status == 0);
+  CHECK(off.out.find("stored with a pinch gap of 8.0 mm") != std::string::npos);
+  CHECK(off.out.find("not compared") != std::string::npos);
+  CHECK(gdsr_run(dir, "data check --data '" + out + "' --pinch-gap -1").status != 0);
   // Each frame's figures as CSV: a header and one line per frame.
   const std::string csv = dir / "frames.csv";
   CHECK(gdsr_run(dir, "data check --data '" + out + "' --per-frame '" + csv + "'").status == 0);

@@ -117,8 +117,10 @@ TEST_CASE("gdsr: validity counts penetration under a second body part as a pinch
   CHECK(v.hr.max_penetration_free_frame == 1);
   CHECK(v.hr.frames_over_limit_free == 0);
   CHECK(v.hr.pinch_frames == 1);
-  // A reach shorter than the 1 cm gap: no pinch, everything counts.
+  // A reach shorter than the 1 cm gap: no pinch, everything counts (with the crease rule off: the
+  // hand's 2 mm over the body is a closed crease to it).
   opt.pinch_reach = 0.005;
+  opt.pinch_gap = 0;
   const gdsr::ValidityFigures narrow = gdsr::measure_validity(d, opt);
   CHECK(narrow.lr.max_penetration_free == doctest::Approx(0.008).epsilon(1e-9));
   CHECK(narrow.lr.pinch_frames == 0);
@@ -155,9 +157,11 @@ TEST_CASE("gdsr: body_depths gives each vertex its depth in the body and whether
   // HR is 2 mm higher: 2 mm and 6 mm deep in frames 1 and 2.
   const gdsr::BodyDepths hr = gdsr::body_depths(d, 2, d.hr_frames[2]);
   CHECK(*std::max_element(hr.depth.begin(), hr.depth.end()) == doctest::Approx(0.006).epsilon(1e-9));
-  // The reach is an option, as for the figures: 5 mm does not get to the hand 1 cm up.
+  // The reach is an option, as for the figures: 5 mm does not get to the hand 1 cm up (the
+  // crease rule off, as above).
   gdsr::ValidityOptions opt;
   opt.pinch_reach = 0.005;
+  opt.pinch_gap = 0;
   const gdsr::BodyDepths narrow = gdsr::body_depths(d, 2, d.lr_frames[2], opt);
   CHECK(std::count(narrow.pinched.begin(), narrow.pinched.end(), 1) == 0);
   CHECK_THROWS_AS(gdsr::body_depths(d, 4, d.lr_frames[0]), gdsr::Error);
@@ -187,11 +191,61 @@ TEST_CASE("gdsr: validity finds a pinching part by its surface, not its vertices
   CHECK(v.lr.frames_over_limit_free == 1);  // frame 1 (4 mm), the plate 1 m away
   CHECK(v.lr.max_penetration_free == doctest::Approx(0.004).epsilon(1e-9));
   CHECK(v.hr.pinch_frames == 1);
-  // The LR vertex is 1 cm under the plate: a reach just short of it finds no pinch.
+  // The LR vertex is 1 cm under the plate: a reach just short of it finds no pinch (the crease
+  // rule off, as above).
   opt.pinch_reach = 0.0099;
+  opt.pinch_gap = 0;
   CHECK(gdsr::measure_validity(d, opt).lr.pinch_frames == 0);
   opt.pinch_reach = 0.0101;
   CHECK(gdsr::measure_validity(d, opt).lr.pinch_frames == 1);
+}
+
+TEST_CASE("gdsr: validity counts cloth in a closed crease of one part as a pinch, by the gap it is trapped in") {
+  // A closed elbow: the rising box of the tests above plus a "forearm" box 1 cm above the sheet
+  // in every frame, the same part as the body box (within pinch_separation of it in frame 0),
+  // so no second part pinches. The LR vertex (0.165, 0.15, 0) poking 8 mm into the body box in
+  // frame 2 lies in a gap of 2 mm between the two (the top at 8 mm, the forearm at 10 mm); in
+  // frame 1, 4 mm deep, the gap is 6 mm. Ray from the body's closest point along the way out.
+  const std::vector<double> top = {0.001, 0.004, 0.008, 0.003};
+  gdsr::Dataset d = gdsr_test::stretched_dataset(top);
+  const gdsr::TriMesh forearm = gdsr_test::box(0.14, 0.19, 0.13, 0.17, 0.01, 0.05);
+  gdsr_test::add_second_part(d, forearm, forearm);
+  gdsr::ValidityOptions opt;
+  opt.penetration_limit = 0.0035;
+  opt.pinch_gap = 0.005;
+  const gdsr::ValidityFigures v = gdsr::measure_validity(d, opt);
+  CHECK(v.lr.pinch_frames == 1);  // frame 2
+  CHECK(v.lr.max_penetration_free == doctest::Approx(0.004).epsilon(1e-9));
+  CHECK(v.lr.max_penetration_free_frame == 1);
+  CHECK(v.lr.frames_over_limit_free == 1);
+  const gdsr::BodyDepths bd = gdsr::body_depths(d, 2, d.lr_frames[2], opt);
+  CHECK(std::count(bd.pinched.begin(), bd.pinched.end(), 1) == 1);
+  // A gap wider than pinch_gap is room for the cloth: no pinch, both frames count.
+  opt.pinch_gap = 0.0015;
+  const gdsr::ValidityFigures wide = gdsr::measure_validity(d, opt);
+  CHECK(wide.lr.pinch_frames == 0);
+  CHECK(wide.lr.max_penetration_free == doctest::Approx(0.008).epsilon(1e-9));
+  CHECK(wide.lr.frames_over_limit_free == 2);
+  // Pinch_gap 0 turns the rule off; the default (8 mm) takes frames 1 and 2 as pinches.
+  opt.pinch_gap = 0;
+  CHECK(gdsr::measure_validity(d, opt).lr.pinch_frames == 0);
+  gdsr::ValidityOptions dflt;
+  dflt.penetration_limit = 0.0035;
+  const gdsr::ValidityFigures by_default = gdsr::measure_validity(d, dflt);
+  CHECK(by_default.lr.pinch_frames == 2);
+  // The manifest records the gap; manifests from before the rule read 0 (measured without it).
+  CHECK(gdsr::validity_from_json(gdsr::validity_to_json(by_default)).pinch_gap == doctest::Approx(0.008));
+  nlohmann::json old = gdsr::validity_to_json(by_default);
+  old.erase("pinch_gap_m");
+  CHECK(gdsr::validity_from_json(old).pinch_gap == 0);
+  // The forearm moved aside (not over the closest point's way out): no crease, no pinch.
+  gdsr::Dataset aside = gdsr_test::stretched_dataset(top);
+  const gdsr::TriMesh beside = gdsr_test::box(0.22, 0.27, 0.13, 0.17, 0.01, 0.05);
+  gdsr_test::add_second_part(aside, beside, beside);
+  CHECK(gdsr::measure_validity(aside, dflt).lr.pinch_frames == 0);
+  CHECK(gdsr::measure_validity(aside, dflt).lr.frames_over_limit_free == 2);
+  opt.pinch_gap = -0.001;
+  CHECK_THROWS_AS(gdsr::measure_validity(d, opt), gdsr::Error);
 }
 
 TEST_CASE("gdsr: validity counts the frames where the body crosses itself, and the pinches among them") {
