@@ -433,6 +433,7 @@ struct PreviewArgs {
   bool body = true;
   bool intersections = false;  // paint the faces of intersecting pairs red
   bool penetration = false;    // paint the faces inside the body (outside pinches magenta, pinched cyan)
+  double pinch_gap_mm = 1e3 * gdsr::ValidityOptions{}.pinch_gap;  // the crease rule of `data check`
   std::string view = "front";  // where the camera is, relative to the body's first pose (Y-up, facing +z)
 };
 
@@ -476,8 +477,10 @@ struct InBody {
   int faces = 0, pinched = 0;  // faces marked kInBody / kPinched (whatever mark they kept)
   double deepest = 0;          // metres, deepest corner outside pinches (0: none past the limit)
 };
-InBody mark_penetration(const gdsr::Dataset& d, int t, const gdsr::TriMesh& g, std::vector<int>& mark) {
-  const gdsr::ValidityOptions opt;
+InBody mark_penetration(const gdsr::Dataset& d, int t, const gdsr::TriMesh& g, double pinch_gap,
+                        std::vector<int>& mark) {
+  gdsr::ValidityOptions opt;
+  opt.pinch_gap = pinch_gap;
   const gdsr::BodyDepths bd = gdsr::body_depths(d, t, g.V, opt);
   InBody r;
   for (int f = 0; f < g.F.rows(); ++f) {
@@ -555,7 +558,7 @@ void run_preview(const PreviewArgs& a) {
     std::vector<int> mark(g.F.rows(), kPlain);
     if (a.intersections) note += ", " + std::to_string(mark_intersections(g, mark)) + " faces intersect";
     if (a.penetration) {
-      const InBody in = mark_penetration(d, t, g, mark);
+      const InBody in = mark_penetration(d, t, g, 1e-3 * a.pinch_gap_mm, mark);
       note += ", " + std::to_string(in.faces) + " in body (" + std::to_string(in.pinched) + " pinched)";
       std::printf("%s: %d faces with a corner > %g mm in the body outside pinches (deepest %.1f mm), %d pinched\n",
                   name, in.faces, 1000 * gdsr::ValidityOptions{}.penetration_limit, 1000 * in.deepest, in.pinched);
@@ -846,6 +849,10 @@ void add_data_command(CLI::App& app) {
   prev->add_flag("--penetration", pv->penetration,
                  "paint faces with a corner more than 5 mm inside the body magenta, cyan where a second body part "
                  "or a closed crease pinches it (the rule of `data check`), drawn through the body");
+  prev->add_option("--pinch-gap", pv->pinch_gap_mm,
+                   "mm: with --penetration, as for `data check` (0: no crease pinches)")
+      ->capture_default_str()
+      ->check(finite_range(0.0, 1000.0));
   std::vector<std::string> view_names;
   for (const View& v : kViews) view_names.push_back(v.name);
   prev->add_option("--view", pv->view, "camera on the body's front, back, left, right or top")

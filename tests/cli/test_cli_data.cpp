@@ -230,6 +230,23 @@ TEST_CASE("cli data: preview --penetration paints and counts the faces in the bo
   CHECK(pixels(png2, true) == 0);
   CHECK(pixels(png2, false) > 0);
   if (out1.find("LR: ") == std::string::npos) MESSAGE("stdout: " << out1);
+  // A closed crease of one part: the second box stays 1 cm above the sheet in every frame, the same
+  // part as the body box, so in frame 1 the 8 mm-deep cloth lies in a 2 mm gap: pinched, as in
+  // `data check`, and outside pinches with --pinch-gap 0.
+  gdsr::Dataset crease = gdsr_test::stretched_dataset({0.001, 0.008, 0.008, 0.003});
+  const gdsr::TriMesh forearm = gdsr_test::box(0.14, 0.19, 0.13, 0.17, 0.01, 0.05);
+  gdsr_test::add_second_part(crease, forearm, forearm);
+  gdsr::write_dataset(dir / "crease", crease);
+  auto crease_preview = [&](const std::string& flags) {
+    return gdsr_run(dir, "data preview --data '" + (dir / "crease") + "' --frame 1 --penetration --size 96 --out '" +
+                             (dir / "c.png") + "'" + flags);
+  };
+  const Run pinched = crease_preview(""), off = crease_preview(" --pinch-gap 0");
+  CHECK(pinched.out.find("LR: 0 faces with a corner > 5 mm in the body outside pinches (deepest 0.0 mm), " +
+                         std::to_string(lr_faces) + " pinched") != std::string::npos);
+  CHECK(off.out.find("LR: " + std::to_string(lr_faces) + " faces with a corner > 5 mm in the body outside pinches " +
+                     "(deepest 8.0 mm), 0 pinched") != std::string::npos);
+  CHECK(crease_preview(" --pinch-gap nan").status != 0);
   // A dataset without a body: one line naming the flag, no picture.
   gdsr::Dataset bodiless = gdsr_test::wave_dataset(2);
   gdsr::write_dataset(dir / "nobody", bodiless);
