@@ -426,6 +426,17 @@ void run_recipe(const MakeArgs& a) {
   std::printf("train on it: %s --out RUN\n", cmd.c_str());
 }
 
+// --pinch-gap in mm (gdsr::ValidityOptions::pinch_gap), for `data check` and `data preview`.
+double default_pinch_gap_mm() { return 1e3 * gdsr::ValidityOptions{}.pinch_gap; }
+void add_pinch_gap_option(CLI::App* cmd, double& mm, const std::string& lead) {
+  cmd->add_option("--pinch-gap", mm,
+                  "mm: " + lead +
+                      "cloth in a crease of one body part closed to less than this is pinched (0: off, as manifests "
+                      "measured before the crease rule)")
+      ->capture_default_str()
+      ->check(finite_range(0.0, 1000.0));
+}
+
 struct PreviewArgs {
   std::string data, out;
   int frame = -1;  // <0: last frame
@@ -433,7 +444,7 @@ struct PreviewArgs {
   bool body = true;
   bool intersections = false;  // paint the faces of intersecting pairs red
   bool penetration = false;    // paint the faces inside the body (outside pinches magenta, pinched cyan)
-  double pinch_gap_mm = 1e3 * gdsr::ValidityOptions{}.pinch_gap;  // the crease rule of `data check`
+  double pinch_gap_mm = default_pinch_gap_mm();  // the crease rule of `data check`
   std::string view = "front";  // where the camera is, relative to the body's first pose (Y-up, facing +z)
 };
 
@@ -620,7 +631,7 @@ struct CheckArgs {
   std::string per_frame;  // non-empty: write each frame's figures to this CSV
   int intersection_stride = kDefaultIntersectionStride;
   bool body = true;
-  double pinch_gap_mm = 1e3 * gdsr::ValidityOptions{}.pinch_gap;
+  double pinch_gap_mm = default_pinch_gap_mm();
 };
 
 // "same" if every number of `a` equals the one at the same place in `b` (relative 1e-9),
@@ -849,10 +860,7 @@ void add_data_command(CLI::App& app) {
   prev->add_flag("--penetration", pv->penetration,
                  "paint faces with a corner more than 5 mm inside the body magenta, cyan where a second body part "
                  "or a closed crease pinches it (the rule of `data check`), drawn through the body");
-  prev->add_option("--pinch-gap", pv->pinch_gap_mm,
-                   "mm: with --penetration, as for `data check` (0: no crease pinches)")
-      ->capture_default_str()
-      ->check(finite_range(0.0, 1000.0));
+  add_pinch_gap_option(prev, pv->pinch_gap_mm, "with --penetration, as for `data check`: ");
   std::vector<std::string> view_names;
   for (const View& v : kViews) view_names.push_back(v.name);
   prev->add_option("--view", pv->view, "camera on the body's front, back, left, right or top")
@@ -886,11 +894,7 @@ void add_data_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   ch->add_flag("!--no-body", chk->body, "do not measure the body penetration");
-  ch->add_option("--pinch-gap", chk->pinch_gap_mm,
-                 "mm: cloth in a crease of one body part closed to less than this is pinched (0: off, as manifests "
-                 "measured before the crease rule)")
-      ->capture_default_str()
-      ->check(finite_range(0.0, 1000.0));
+  add_pinch_gap_option(ch, chk->pinch_gap_mm, "");
   ch->add_option("--per-frame", chk->per_frame,
                  "also write each frame's figures to this CSV (intersecting pairs, depth outside pinches, agreement)");
   ch->callback([chk]() { run_check(*chk); });
