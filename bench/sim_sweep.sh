@@ -9,6 +9,11 @@
 # - untangling, where a lunge pinches the 10 mm trouser leg behind the knee at frame 44 of
 #   131_01 (0: off, revision 11; 0.3 crumples the cloth: 16,407 pairs):
 #     bench/sim_sweep.sh build OUT --untangle-step "0 0.05 0.1"
+# - which body parts pass through pinned cloth: in the same lunge (a kneel) the thigh closes onto
+#   the calf with the trouser in the crook; at 0 it passed through the cloth as a hand does and the
+#   leg left the trouser leg (revision 29: 30 mm pants, LR frames with cloth > 5 mm inside the body
+#   outside pinches 102 -> 18, HR 83 -> 5):
+#     bench/sim_sweep.sh build OUT --dressed-radius "0 0.05"
 # - chaos: the same clip with the friction nudged by 1e-5 (0.3 is the default). A solver change
 #   whose figures stay inside this spread is not measured by one run of each: the 10 mm pants
 #   on 131_02 gave 44.1%, 100% and 97.1% of HR frames free of self-intersections (revision 12):

@@ -69,7 +69,8 @@ struct MakeArgs {
       self_passes = -1;
   double friction = NAN, bend_stiffness = NAN, self_thickness = NAN, compression_ratio = NAN,
          compression_exponent = NAN, self_slack = NAN;
-  double self_slack_per_pd = NAN, untangle_step = NAN, max_push_step = NAN, pinch_separation = NAN;
+  double self_slack_per_pd = NAN, untangle_step = NAN, max_push_step = NAN, pinch_separation = NAN,
+         dressed_radius = NAN;
   double contact_travel = NAN;
   double arm_clearance = 0.01;  // metres, gdsr::BodyOptions::arm_clearance (0: the motion as in the file)
   double pin_yield_rate = NAN;
@@ -218,6 +219,7 @@ void run_make(const MakeArgs& a) {
   if (!std::isnan(a.untangle_step)) params.untangle_step = a.untangle_step;
   if (!std::isnan(a.max_push_step)) params.max_push_step = a.max_push_step;
   if (!std::isnan(a.pinch_separation)) params.pinch_separation = a.pinch_separation;
+  if (!std::isnan(a.dressed_radius)) params.dressed_radius = a.dressed_radius;
   params.track_rate = effective_track_rate(a);
   params.self_collision = a.self_collision;
   params.limbs_pass_through = a.limbs_pass_through;
@@ -281,6 +283,7 @@ void run_make(const MakeArgs& a) {
                   {"limbs_pass_until_clear", params.limbs_pass_until_clear},
                   {"max_push_step_m", params.max_push_step},
                   {"pinch_separation_m", params.pinch_separation},
+                  {"dressed_radius_m", params.dressed_radius},
                   {"self_thickness_m", params.self_thickness},
                   {"self_thickness_per_pd", params.self_thickness_per_pd},
                   {"self_slack_m", params.self_slack},
@@ -785,6 +788,11 @@ void add_data_command(CLI::App& app) {
                    "metres: body points this far apart in the first pose are different parts, cloth pinched "
                    "between them stays on the part it was dressed on (default: the solver's)")
       ->check(finite_range(0.01, 1.0));
+  make->add_option("--dressed-radius", mk->dressed_radius,
+                   "metres: body points this close to where some cloth was dressed (its closest body point in the "
+                   "first pose) are under the garment, and only parts outside it pass through pinned cloth (default: "
+                   "the solver's; 0: every part far from the cloth's own, as before solver revision 29)")
+      ->check(finite_range(0.0, 1.0));
   make->add_option("--track-rate", mk->track_rate,
                    "1/s: HR follows the LR simulation at the LR scale, a difference in drape decaying at this rate, "
                    "and adds finer wrinkles (default: the solver's, 30; 0: independent, as before revision 13)")

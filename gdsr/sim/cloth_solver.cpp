@@ -3,6 +3,7 @@
 #include "gdsr/error.hpp"
 
 #include <Eigen/Geometry>
+#include <nanoflann.hpp>
 #include <omp.h>
 #include <algorithm>
 #include <array>
@@ -24,6 +25,27 @@ namespace {
 // A pin is pressed towards its home only by a part pushing it that way at more than this cosine:
 // at a grazing angle a push of depth C moves the pin C over the cosine.
 constexpr double kMinPinPress = 0.2;
+
+// Per row of P: 1 where a finite row of Q lies within r of it (metres).
+std::vector<char> points_near(const Points3& P, const Points3& Q, double r) {
+  std::vector<char> near(P.rows(), 0);
+  Points3 finite(Q.rows(), 3);
+  Eigen::Index n = 0;
+  for (Eigen::Index i = 0; i < Q.rows(); ++i)
+    if (Q.row(i).allFinite()) finite.row(n++) = Q.row(i);
+  if (n == 0 || !(r > 0)) return near;
+  finite.conservativeResize(n, 3);
+  using Tree = nanoflann::KDTreeEigenMatrixAdaptor<Points3, 3, nanoflann::metric_L2_Simple>;
+  Tree tree(3, std::cref(finite), 10);
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    const double q[3] = {P(i, 0), P(i, 1), P(i, 2)};
+    Eigen::Index nearest = 0;
+    double d2 = 0;
+    tree.index->knnSearch(q, 1, &nearest, &d2);
+    near[i] = d2 <= r * r;
+  }
+  return near;
+}
 
 double cot(const Vec2& a, const Vec2& b) {  // cotangent of the angle between a and b
   const double c = a.dot(b);
@@ -72,6 +94,7 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
   if (!(p.compression_pd_exponent >= 0 && p.compression_pd_exponent <= 4))
     gdsr::fail("sim/cloth_solver", "compression_pd_exponent must be in [0, 4]");
   if (!(p.contact_release_stretch > 1)) gdsr::fail("sim/cloth_solver", "contact_release_stretch must be > 1");
+  if (!(p.dressed_radius >= 0)) gdsr::fail("sim/cloth_solver", "dressed_radius must be >= 0");
   if (!(p.max_push_step > 0)) gdsr::fail("sim/cloth_solver", "max_push_step must be positive");
   if (g.particle_distance > 0)
     p_.compression_ratio = std::min(
@@ -165,6 +188,7 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
       const SurfaceHit hit = wide.closest(x_.row(v).transpose(), body_V0, 0.3);
       if (hit.face >= 0) home_.row(v) = hit.point.transpose();
     }
+    under_garment_ = points_near(body_V0, home_, p.dressed_radius);
   }
   if (!g.pinned.empty() && body_F.rows() == 0) {  // no body: pinned vertices are fixed in space
     for (int v : g.pinned) {
@@ -380,9 +404,12 @@ void ClothSolver::refresh_contacts(const Points3& body_now, double h) {
       if (a.face < 0) continue;
       const Vec3 ra = bary_point(body_rest_, bodyF_, a.face, a.bary);
       const bool dressed = home_.row(v).allFinite();
-      // Lost inside a part it was not dressed on (limbs_pass_through): a hand, not the leg a
-      // trouser leg hangs on.
-      if (a.signed_distance <= -p_.max_push && anchored_[v] &&
+      // Lost inside a part it was not dressed on and no cloth was dressed on (limbs_pass_through,
+      // dressed_radius): a hand, not the leg a trouser leg hangs on, nor the thigh that a kneel
+      // closes onto the calf with the trouser in the crook.
+      const bool under_garment =
+          under_garment_[bodyF_(a.face, 0)] || under_garment_[bodyF_(a.face, 1)] || under_garment_[bodyF_(a.face, 2)];
+      if (a.signed_distance <= -p_.max_push && anchored_[v] && !under_garment &&
           (!dressed || (ra - home_.row(v).transpose()).squaredNorm() > sep2))
         pierced[v] = {v, a.face, a.bary};
       // A second body part within reach (far from the first one in the first pose): the cloth

@@ -338,7 +338,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
                         " --self-slack 0.002 --self-detect-every 3 --self-slack-per-pd 0.25 --self-passes 2"
                         " --no-limbs-pass-through --no-limbs-pass-until-clear --untangle-step 0.25 --no-self-redetect"
                         " --track-rate 4 --max-push-step 0.01 --pinch-separation 0.08 --contact-travel 0"
-                        " --pin-yield-rate 2.5");
+                        " --pin-yield-rate 2.5 --dressed-radius 0.02");
   REQUIRE(mk.status == 0);
   const std::string manifest = gdsr_test::slurp(out + "/manifest.json");
   CHECK(manifest.find("\"iterations\": 3") != std::string::npos);
@@ -362,6 +362,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"hr_track_rate_1_s\": 4") != std::string::npos);
   CHECK(manifest.find("\"max_push_step_m\": 0.01") != std::string::npos);
   CHECK(manifest.find("\"pinch_separation_m\": 0.08") != std::string::npos);
+  CHECK(manifest.find("\"dressed_radius_m\": 0.02") != std::string::npos);
   CHECK(manifest.find("\"layer_gap_m\": 0.004") != std::string::npos);  // the infer layer offset's default
   for (const std::string bad : {"--iterations 0",           "--friction -1",         "--self-thickness 1",
                                 "--bend-stiffness -2",      "--compression-ratio 0", "--compression-exponent -1",
@@ -369,7 +370,8 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
                                 "--self-slack 0",           "--self-detect-every 0", "--self-passes 0",
                                 "--self-slack-per-pd 0",    "--untangle-step -0.1",  "--track-rate -1",
                                 "--track-rate nan",         "--max-push-step 0",     "--pinch-separation 0",
-                                "--contact-travel -1",      "--pin-yield-rate -1"}) {
+                                "--contact-travel -1",      "--pin-yield-rate -1",   "--dressed-radius -0.01",
+                                "--dressed-radius nan"}) {
     const Run r = gdsr_run(dir, "data make --out '" + (dir / "bad") + "' " + bad);
     CHECK(r.status == 1);  // a refusal, not a crash (a sanitizer report exits 99)
     CHECK(r.err.find(bad.substr(0, bad.find(' '))) != std::string::npos);
