@@ -302,6 +302,12 @@ void ClothSolver::place_pins(const Points3& body, double h) {
   }
 }
 
+bool ClothSolver::under_garment(int body_face) const {
+  for (int k = 0; k < 3; ++k)
+    if (under_garment_[bodyF_(body_face, k)]) return true;
+  return false;
+}
+
 bool ClothSolver::in_part(const Contact& c, const Vec3& part) const {
   return (bary_point(body_rest_, bodyF_, c.face, c.bary) - part).squaredNorm() <=
          p_.pinch_separation * p_.pinch_separation;
@@ -407,10 +413,8 @@ void ClothSolver::refresh_contacts(const Points3& body_now, double h) {
       // Lost inside a part it was not dressed on and no cloth was dressed on (limbs_pass_through,
       // dressed_radius): a hand, not the leg a trouser leg hangs on, nor the thigh that a kneel
       // closes onto the calf with the trouser in the crook.
-      const bool under_garment =
-          under_garment_[bodyF_(a.face, 0)] || under_garment_[bodyF_(a.face, 1)] || under_garment_[bodyF_(a.face, 2)];
-      if (a.signed_distance <= -p_.max_push && anchored_[v] && !under_garment &&
-          (!dressed || (ra - home_.row(v).transpose()).squaredNorm() > sep2))
+      if (a.signed_distance <= -p_.max_push && anchored_[v] &&
+          (!dressed || (ra - home_.row(v).transpose()).squaredNorm() > sep2) && !under_garment(a.face))
         pierced[v] = {v, a.face, a.bary};
       // A second body part within reach (far from the first one in the first pose): the cloth
       // may be pinched between them (a hand pressing a skirt onto the hip). Both contacts

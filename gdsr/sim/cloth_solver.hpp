@@ -534,6 +534,8 @@ class ClothSolver {
 
   // h: the substep, seconds (the search reaches as far as the cloth travels until the next refresh).
   void refresh_contacts(const gdsr::Points3& body_now, double h);
+  // Whether a corner of body face `body_face` is under the garment (SimParams::dressed_radius).
+  bool under_garment(int body_face) const;
   // Whether contact c is with the body part around `part` (within pinch_separation of it in the first pose).
   bool in_part(const Contact& c, const gdsr::Vec3& part) const;
   // The contacts of vertex u with the body part around `part` (body points within
