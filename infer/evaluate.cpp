@@ -7,8 +7,6 @@
 #include "gdsr/geometry/geometry_ad.hpp"
 #include "gdsr/geometry/mesh_ops.hpp"
 
-#include <opencv2/quality/qualityssim.hpp>
-
 #include <stdexcept>
 
 namespace gdsr {
@@ -31,14 +29,12 @@ cv::Mat uv_normal_map(const UVRaster& raster, const Faces& F, const Points3& V) 
   return img;
 }
 
-double ssim(const cv::Mat& a, const cv::Mat& b) {
-  if (a.size() != b.size() || a.type() != b.type()) gdsr::fail("ssim", "images differ in size or type");
-  // OpenCV's SSIM constants C1 = (0.01 * 255)^2, C2 = (0.03 * 255)^2 assume 0..255 pixels.
-  cv::Mat a255, b255;
-  a.convertTo(a255, CV_32F, 255.0);
-  b.convertTo(b255, CV_32F, 255.0);
-  const cv::Scalar s = cv::quality::QualitySSIM::compute(a255, b255, cv::noArray());
-  return (s[0] + s[1] + s[2]) / 3.0;
+cv::Mat garment_mask(const UVRaster& raster) {
+  cv::Mat mask(raster.height, raster.width, CV_8U, cv::Scalar(0));
+  for (int j = 0; j < raster.height; ++j)
+    for (int i = 0; i < raster.width; ++i)
+      if (raster.tri[static_cast<size_t>(j) * raster.width + i] >= 0) mask.at<uint8_t>(j, i) = 255;
+  return mask;
 }
 
 namespace {
@@ -61,6 +57,7 @@ Evaluation evaluate(const Dataset& d, const std::vector<Points3>& G, int first_f
   if (ssim_every < 1) ssim_every = 1;
   Evaluation ev;
   int n_ssim = 0;
+  const cv::Mat mask = garment_mask(d.raster);
   const int count = static_cast<int>(G.size());
   for (int k = 0; k < count; ++k) {
     const int t = first_frame + k;
@@ -78,12 +75,18 @@ Evaluation evaluate(const Dataset& d, const std::vector<Points3>& G, int first_f
     if (k % ssim_every == 0) {
       const cv::Mat ref = uv_normal_map(d.raster, d.hr.F, truth);
       f.has_ssim = true;
-      f.ssim = ssim(uv_normal_map(d.raster, d.hr.F, G[k]), ref);
-      f.ssim_lr = ssim(uv_normal_map(d.raster, d.hr.F, up), ref);
-      f.ssim_scale = ssim(uv_normal_map(d.raster, d.hr.F, scale), ref);
+      const SsimScore g = ssim_score(uv_normal_map(d.raster, d.hr.F, G[k]), ref, mask);
+      const SsimScore lr = ssim_score(uv_normal_map(d.raster, d.hr.F, up), ref, mask);
+      const SsimScore sc = ssim_score(uv_normal_map(d.raster, d.hr.F, scale), ref, mask);
+      f.ssim = g.whole, f.ssim_garment = g.garment;
+      f.ssim_lr = lr.whole, f.ssim_garment_lr = lr.garment;
+      f.ssim_scale = sc.whole, f.ssim_garment_scale = sc.garment;
       ev.mean.ssim += f.ssim;
       ev.mean.ssim_lr += f.ssim_lr;
       ev.mean.ssim_scale += f.ssim_scale;
+      ev.mean.ssim_garment += f.ssim_garment;
+      ev.mean.ssim_garment_lr += f.ssim_garment_lr;
+      ev.mean.ssim_garment_scale += f.ssim_garment_scale;
       ++n_ssim;
     }
     f.energies = strain_energies(d.hr, G[k]);
@@ -102,6 +105,9 @@ Evaluation evaluate(const Dataset& d, const std::vector<Points3>& G, int first_f
     ev.mean.ssim /= n_ssim;
     ev.mean.ssim_lr /= n_ssim;
     ev.mean.ssim_scale /= n_ssim;
+    ev.mean.ssim_garment /= n_ssim;
+    ev.mean.ssim_garment_lr /= n_ssim;
+    ev.mean.ssim_garment_scale /= n_ssim;
   }
   ev.mean.frame = -1;
   ev.truth = ev.mean.energies_hr;

@@ -8,6 +8,7 @@
 #include "gdsr/io/progress.hpp"
 #include "gdsr/data/dataset.hpp"
 #include "gdsr/geometry/strain.hpp"
+#include "gdsr/io/ssim.hpp"
 
 #include <opencv2/core.hpp>
 
@@ -20,19 +21,22 @@ namespace gdsr {
 // renormalised, as in training); background black. CV_32FC3 in 0..1, RGB = xyz.
 cv::Mat uv_normal_map(const UVRaster& raster, const Faces& F, const Points3& V);
 
-// Mean SSIM over the three channels (OpenCV quality module, Gaussian window 11, sigma 1.5)
-// of two CV_32FC3 images with values in 0..1.
-double ssim(const cv::Mat& a, const cv::Mat& b);
+// The pixels a garment triangle covers: CV_8U, 255 on the garment, 0 on the layout's background
+// (the mask of ssim_score's garment figure).
+cv::Mat garment_mask(const UVRaster& raster);
 
 struct FrameEvaluation {
   int frame = 0;
   double error = 0;            // mean |G - G*| over HR vertices, metres
   double error_lr = 0;         // the same for the LR simulation upsampled (baseline)
   bool has_ssim = false;       // SSIM computed on this frame (every ssim_every-th)
-  double ssim = 0;             // normal maps of G vs G*
+  double ssim = 0;             // normal maps of G vs G*, whole image (ssim_score)
   double ssim_lr = 0;          // normal maps of the upsampled LR vs G*
   double error_scale = 0;      // mean |S - G*|, S = at_lr_scale(G*) (perfect E, no A)
   double ssim_scale = 0;       // normal maps of S vs G*
+  double ssim_garment = 0;     // the three SSIMs above over the garment's pixels only (ssim_score)
+  double ssim_garment_lr = 0;
+  double ssim_garment_scale = 0;
   StrainEnergies energies;     // of G
   StrainEnergies energies_lr;  // of the upsampled LR (baseline)
   StrainEnergies energies_hr;  // of the ground truth G*

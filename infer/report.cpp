@@ -25,7 +25,11 @@ nlohmann::json frame_json(const FrameEvaluation& f) {
                    {"energies", energies_json(f.energies)},
                    {"energies_lr", energies_json(f.energies_lr)},
                    {"energies_hr", energies_json(f.energies_hr)}};
-  if (f.has_ssim) j["ssim"] = f.ssim, j["ssim_lr"] = f.ssim_lr, j["ssim_hr_lr_scale"] = f.ssim_scale;
+  if (f.has_ssim) {
+    j["ssim"] = f.ssim, j["ssim_lr"] = f.ssim_lr, j["ssim_hr_lr_scale"] = f.ssim_scale;
+    j["ssim_garment"] = f.ssim_garment, j["ssim_garment_lr"] = f.ssim_garment_lr;
+    j["ssim_garment_hr_lr_scale"] = f.ssim_garment_scale;
+  }
   return j;
 }
 
@@ -89,6 +93,9 @@ std::vector<std::string> write_eval_report(const std::string& dir, const Dataset
   j["mean"]["ssim"] = e.mean.ssim;
   j["mean"]["ssim_lr"] = e.mean.ssim_lr;
   j["mean"]["ssim_hr_lr_scale"] = e.mean.ssim_scale;
+  j["mean"]["ssim_garment"] = e.mean.ssim_garment;
+  j["mean"]["ssim_garment_lr"] = e.mean.ssim_garment_lr;
+  j["mean"]["ssim_garment_hr_lr_scale"] = e.mean.ssim_garment_scale;
   for (const auto& f : e.frames) j["per_frame"].push_back(frame_json(f));
   write_file_atomic((fs::path(dir) / "report.json").string(), j.dump(1));
   files.push_back("report.json");

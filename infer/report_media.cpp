@@ -82,17 +82,33 @@ cv::Mat plot_error(const Evaluation& e) {
 }
 
 cv::Mat plot_ssim(const Evaluation& e) {
-  std::vector<double> x, s, s_lr, s_scale;
+  std::vector<double> x;
   for (const auto& f : e.frames)
-    if (f.has_ssim)
-      x.push_back(f.frame), s.push_back(f.ssim), s_lr.push_back(f.ssim_lr), s_scale.push_back(f.ssim_scale);
+    if (f.has_ssim) x.push_back(f.frame);
   if (x.empty()) gdsr::fail("plot_ssim", "no frame has an SSIM");
+  const auto series = [&](double FrameEvaluation::*field) {
+    std::vector<double> s;
+    for (const auto& f : e.frames)
+      if (f.has_ssim) s.push_back(f.*field);
+    return s;
+  };
   PlotOptions o;
-  o.title = "Normal-map SSIM to the HR simulation";
-  o.x_label = "dataset frame";
+  o.title = "Normal-map SSIM, whole map";
+  o.height = 280;
   o.y_label = "SSIM";
-  return line_plot({{"Upsampled LR", x, s_lr, kLr}, {"GDSR", x, s, kGdsr}, {"HR at the LR scale", x, s_scale, kScale}},
-                   o);
+  const cv::Mat whole = line_plot({{"Upsampled LR", x, series(&FrameEvaluation::ssim_lr), kLr},
+                                   {"GDSR", x, series(&FrameEvaluation::ssim), kGdsr},
+                                   {"HR at the LR scale", x, series(&FrameEvaluation::ssim_scale), kScale}},
+                                  o);
+  o.title = "SSIM, garment pixels only";
+  o.x_label = "dataset frame";
+  const cv::Mat garment = line_plot({{"Upsampled LR", x, series(&FrameEvaluation::ssim_garment_lr), kLr},
+                                     {"GDSR", x, series(&FrameEvaluation::ssim_garment), kGdsr},
+                                     {"HR at the LR scale", x, series(&FrameEvaluation::ssim_garment_scale), kScale}},
+                                    o);
+  cv::Mat out;
+  cv::vconcat(std::vector<cv::Mat>{whole, garment}, out);
+  return out;
 }
 
 cv::Mat plot_energies(const Evaluation& e) {

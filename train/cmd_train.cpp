@@ -110,8 +110,11 @@ void run_train(TrainArgs& a, const gdsr::MpiRanks& mpi) {
     }
     if (L.validated) {
       std::fprintf(stderr, "\n");
-      std::printf("validation at step %lld: loss %.5g; roll-out vertex error %.2f mm (upsampled LR %.2f mm) on the patches\n",
-                  static_cast<long long>(L.step), L.val_loss, L.val_vertex_mm, L.val_upsample_mm);
+      std::printf(
+          "validation at step %lld: loss %.5g; roll-out vertex error %.2f mm (upsampled LR %.2f mm), normal-map SSIM "
+          "%.4f (upsampled LR %.4f) on the patches\n",
+          static_cast<long long>(L.step), L.val_loss, L.val_vertex_mm, L.val_upsample_mm, L.val_ssim,
+          L.val_upsample_ssim);
       std::fflush(stdout);
     }
   });

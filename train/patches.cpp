@@ -7,6 +7,7 @@
 #include "autograd/ops_matmul.hpp"
 #include "autograd/ops_shape.hpp"
 #include "gdsr/geometry/mesh_ops.hpp"
+#include "gdsr/io/ssim.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -248,5 +249,42 @@ template ag::Tensor<float> draw_normal_map<float>(const ag::Tensor<float>&, cons
 template ag::Tensor<double> draw_normal_map<double>(const ag::Tensor<double>&, const Patch&, double);
 template ag::Tensor<float> normal_map_pixels<float>(const ag::Tensor<float>&, const Patch&);
 template ag::Tensor<double> normal_map_pixels<double>(const ag::Tensor<double>&, const Patch&);
+
+namespace {
+
+// The normal map of one patch of the batch (row k) as a CV_32FC3 image, RGB = xyz.
+cv::Mat patch_normal_image(const PatchBatch& b, size_t k, const Points3& X) {
+  const Patch& p = b.patches[k];
+  Points3 local(static_cast<Eigen::Index>(p.vertices.size()), 3);
+  for (size_t i = 0; i < p.vertices.size(); ++i) local.row(static_cast<Eigen::Index>(i)) = X.row(b.rows[k][i]);
+  const ag::Tensor<double> map = draw_normal_map(vertex_normals(to_tensor<double>(local), p.topo), p);
+  const auto& v = map.values();  // [1 x 3 x S x S], channel-major
+  const int S = p.size;
+  cv::Mat img(S, S, CV_32FC3);
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < S; ++r)
+      for (int col = 0; col < S; ++col)
+        img.at<cv::Vec3f>(r, col)[c] = static_cast<float>(v[(static_cast<size_t>(c) * S + r) * S + col]);
+  return img;
+}
+
+}  // namespace
+
+double patch_normal_map_ssim(const PatchBatch& b, const Points3& pred, const Points3& truth) {
+  const auto n = static_cast<Eigen::Index>(b.vertices.size());
+  if (pred.rows() != n || truth.rows() != n)
+    gdsr::fail("patch_normal_map_ssim", "positions for " + std::to_string(pred.rows()) + " and " +
+                                            std::to_string(truth.rows()) + " vertices, the batch has " +
+                                            std::to_string(n));
+  if (b.patches.empty()) gdsr::fail("patch_normal_map_ssim", "the batch has no patch");
+  double sum = 0;
+  for (size_t k = 0; k < b.patches.size(); ++k) {
+    const Patch& p = b.patches[k];
+    cv::Mat mask(p.size, p.size, CV_8U);
+    for (int i = 0; i < p.size * p.size; ++i) mask.data[i] = p.mask[static_cast<size_t>(i)] ? 255 : 0;
+    sum += ssim_score(patch_normal_image(b, k, pred), patch_normal_image(b, k, truth), mask).garment;
+  }
+  return sum / static_cast<double>(b.patches.size());
+}
 
 }  // namespace gdsr

@@ -102,4 +102,9 @@ ag::Tensor<T> draw_normal_map(const ag::Tensor<T>& vertex_normals, const Patch& 
 // The colour rows of the garment pixels only, [num_garment_pixels x 3] (0.5 n + 0.5).
 template <class T> ag::Tensor<T> normal_map_pixels(const ag::Tensor<T>& vertex_normals, const Patch& p);
 
+// Mean over the batch's patches of the SSIM of their normal maps over garment pixels only
+// (gdsr::ssim_score): validation's image figure. pred, truth: positions of b.vertices (same
+// order), metres. Throws if the row counts differ from b.vertices.
+double patch_normal_map_ssim(const PatchBatch& b, const Points3& pred, const Points3& truth);
+
 }  // namespace gdsr

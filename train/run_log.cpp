@@ -62,10 +62,10 @@ void write_text_atomic(const std::string& path, const std::string& text) {
 
 const std::vector<std::string>& RunLog::columns() {
   static const std::vector<std::string> c = {
-      "step",       "epoch",    "loss",       "coarse",   "fine",      "c_position", "c_normal", "c_strain",
-      "c_smooth",   "c_dihedral", "f_position", "f_vgg",  "f_image_l1", "f_strain",  "f_smooth", "lr",
-      "lambda_c",   "lambda_w", "grad_norm",  "seconds",  "val_loss",  "val_coarse", "val_fine",
-      "val_vertex_mm", "val_upsample_mm"};
+      "step",       "epoch",    "loss",          "coarse",          "fine",      "c_position",       "c_normal",
+      "c_strain",   "c_smooth", "c_dihedral",    "f_position",      "f_vgg",     "f_image_l1",       "f_strain",
+      "f_smooth",   "lr",       "lambda_c",      "lambda_w",        "grad_norm", "seconds",          "val_loss",
+      "val_coarse", "val_fine", "val_vertex_mm", "val_upsample_mm", "val_ssim",  "val_upsample_ssim"};
   return c;
 }
 
@@ -94,9 +94,9 @@ std::string row(const TrainLog& L) {
        num(L.seconds);
   if (L.validated)
     r += "," + num(L.val_loss) + "," + num(L.val_coarse) + "," + num(L.val_fine) + "," + num(L.val_vertex_mm) + "," +
-         num(L.val_upsample_mm);
+         num(L.val_upsample_mm) + "," + num(L.val_ssim) + "," + num(L.val_upsample_ssim);
   else
-    r += ",,,,,";
+    r += ",,,,,,,";
   return r;
 }
 
@@ -116,10 +116,18 @@ RunLog::RunLog(const std::string& dir, int64_t resume_step) : dir_(dir) {
   if (resume_step > 0) {
     std::ifstream in(csv_path());
     std::string line;
-    if (std::getline(in, line) && line == header())
+    // A log written before columns were added at the end (val_ssim, ...) keeps its rows,
+    // padded with empty fields.
+    size_t old_columns = 0;
+    if (std::getline(in, line) && header().compare(0, line.size(), line) == 0 &&
+        (line.size() == header().size() || header()[line.size()] == ','))
+      old_columns = split(line).size();
+    if (old_columns > 0)
       while (std::getline(in, line)) {
-        const std::vector<std::string> f = split(line);
-        if (f.size() != columns().size()) continue;  // a row cut by a kill
+        std::vector<std::string> f = split(line);
+        if (f.size() != old_columns) continue;  // a row cut by a kill
+        for (size_t c = old_columns; c < columns().size(); ++c) line += ",";
+        f.resize(columns().size());
         int64_t step = 0;
         double loss = 0, val = 0;
         try {  // a row that does not parse (cut by a kill, edited by hand) is dropped too

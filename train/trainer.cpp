@@ -193,6 +193,7 @@ struct FrameLoss {
   std::map<std::string, double> terms;  // unweighted
   Points3 C_hat;                        // the corrected LR frame (the next frame's history in a roll-out)
   double vertex_m = 0, upsample_m = 0;  // validation only: mean |G - HR| and |upsampled LR - HR| on the patches
+  double ssim = 0, upsample_ssim = 0;   // validation only: their patches' normal-map SSIM (garment pixels)
 };
 
 // Mean distance, metres, between rows `vertices` of `truth` and the rows of `predicted`
@@ -233,8 +234,18 @@ FrameLoss frame_loss(TrainState& s, Sequence& seq, int t, const Points3& chat_tm
   f.terms = coarse.log();                   // keys c_position, c_normal, ...
   if (opt.fine) f.terms.merge(fine.log());  // f_position, f_vgg, ...
   if (opt.fine && !noise) {
-    f.vertex_m = mean_distance_at(gdsr::to_points(out.G), d.hr_frames[t], batch.vertices, false);
-    f.upsample_m = mean_distance_at(upsample(d.corr, d.lr_frames[t]), d.hr_frames[t], batch.vertices, true);
+    const Points3 G = gdsr::to_points(out.G), up = upsample(d.corr, d.lr_frames[t]);
+    f.vertex_m = mean_distance_at(G, d.hr_frames[t], batch.vertices, false);
+    f.upsample_m = mean_distance_at(up, d.hr_frames[t], batch.vertices, true);
+    const auto rows = [&](const Points3& X) {
+      Points3 out_rows(static_cast<Eigen::Index>(batch.vertices.size()), 3);
+      for (size_t i = 0; i < batch.vertices.size(); ++i)
+        out_rows.row(static_cast<Eigen::Index>(i)) = X.row(batch.vertices[i]);
+      return out_rows;
+    };
+    const Points3 truth = rows(d.hr_frames[t]);
+    f.ssim = patch_normal_map_ssim(batch, G, truth);
+    f.upsample_ssim = patch_normal_map_ssim(batch, rows(up), truth);
   }
   return f;
 }
@@ -415,7 +426,7 @@ void validate(TrainState& s, TrainLog& L, const TrainOptions& opt) {
   ag::NoGradGuard no_grad;
   std::mt19937_64 rng(opt.seed + 0x5eed);
   const Lambdas lambdas = opt.loss.schedule ? lambda_schedule(opt.loss, L.epoch) : Lambdas{1, 1};
-  double total = 0, coarse = 0, fine = 0, vertex = 0, upsampled = 0;
+  double total = 0, coarse = 0, fine = 0, vertex = 0, upsampled = 0, ssim = 0, upsampled_ssim = 0;
   int n = 0;
   for (Sequence& seq : s.val) {
     std::vector<Points3> pred;  // a roll-out from frame 0, as `gdsr infer` runs
@@ -428,6 +439,8 @@ void validate(TrainState& s, TrainLog& L, const TrainOptions& opt) {
       fine += f.fine;
       vertex += f.vertex_m;
       upsampled += f.upsample_m;
+      ssim += f.ssim;
+      upsampled_ssim += f.upsample_ssim;
     }
   }
   L.validated = true;
@@ -437,6 +450,8 @@ void validate(TrainState& s, TrainLog& L, const TrainOptions& opt) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   L.val_vertex_mm = opt.fine ? 1000 * vertex / n : nan;
   L.val_upsample_mm = opt.fine ? 1000 * upsampled / n : nan;
+  L.val_ssim = opt.fine ? ssim / n : nan;
+  L.val_upsample_ssim = opt.fine ? upsampled_ssim / n : nan;
 }
 
 void check_finite_parameters(const TrainState& s) {

@@ -96,6 +96,9 @@ struct TrainLog {
   // mm, mean over the validation frames' patch vertices of |G - HR| (in a roll-out) and, as the
   // yardstick, of |upsampled LR input - HR| at the same vertices; NaN without patches (--no-fine)
   double val_vertex_mm = 0, val_upsample_mm = 0;
+  // the same patches' normal-map SSIM over garment pixels (gdsr::ssim_score), GDSR and the
+  // upsampled LR; NaN without patches
+  double val_ssim = 0, val_upsample_ssim = 0;
 };
 
 struct TrainResult {

@@ -143,6 +143,12 @@ TEST_CASE("cli train: the run folder holds the CSV log and loss curves and confi
   CHECK(std::stod(column(rows[2], 23)) > 0);
   CHECK(std::stod(column(rows[2], 24)) > 0);
   CHECK(column(rows[3], 23).empty());
+  CHECK(header.find("val_upsample_mm,val_ssim,val_upsample_ssim") != std::string::npos);
+  for (int c : {25, 26}) {  // normal-map SSIM of the patches, GDSR and the upsampled LR
+    CHECK(std::stod(column(rows[2], c)) > 0);
+    CHECK(std::stod(column(rows[2], c)) <= 1);
+  }
+  CHECK(r.out.find("normal-map SSIM") != std::string::npos);
   CHECK(r.out.find("validation at step 3: loss") != std::string::npos);
   CHECK(r.out.find("roll-out vertex error") != std::string::npos);
   CHECK(std::stod(column(rows[0], 18)) > 0);  // gradient norm
@@ -157,7 +163,14 @@ TEST_CASE("cli train: the run folder holds the CSV log and loss curves and confi
                 fs::copy_options::overwrite_existing);  // kept to look at
 
   // A log row edited by hand (a step that is not a number) is dropped on --resume, not a crash.
-  std::string log = slurp(out + "/train_log.csv");
+  // The log is also put back into the form of a run made before the validation SSIM columns
+  // (the last two): its rows are kept on --resume, padded.
+  std::string log, line;
+  std::istringstream lines(slurp(out + "/train_log.csv"));
+  while (std::getline(lines, line)) {
+    for (int k = 0; k < 2; ++k) line.erase(line.rfind(','));
+    log += line + "\n";
+  }
   log.replace(log.find('\n') + 1, 1, "x");
   std::ofstream(out + "/train_log.csv", std::ios::trunc) << log;
   const Run resumed =
@@ -166,7 +179,10 @@ TEST_CASE("cli train: the run folder holds the CSV log and loss curves and confi
                         "--frames-per-step 2 --resume '" + out + "/model.ckpt' --out '" + out + "'");
   CHECK(resumed.status == 0);
   CHECK(resumed.err.find("stoll") == std::string::npos);
-  CHECK(csv_rows(out + "/train_log.csv").size() == 14);  // 11 kept, 3 new
+  const std::vector<std::string> kept = csv_rows(out + "/train_log.csv");
+  REQUIRE(kept.size() == 14);                         // 11 kept, 3 new
+  CHECK(column(kept[1], 20) == column(rows[2], 20));  // step 3's validation loss, kept
+  CHECK(column(kept[1], 26).empty());                 // padded
 }
 
 TEST_CASE("cli train: bad flags and files give a one-line error and write nothing") {

@@ -32,3 +32,16 @@ TEST_CASE("evaluate: the HR at the LR scale reproduces a flat tilted sheet exact
   CHECK(flat.mean.ssim_scale == doctest::Approx(1).epsilon(1e-6));
   CHECK(flat.mean.error_lr > 1e-3);  // the LR frames still wave
 }
+
+TEST_CASE("evaluate: garment-pixel SSIM: the truth scores 1, the LR baseline lower than on the whole map") {
+  const gdsr::Dataset d = gdsr_test::wave_dataset(3);
+  const gdsr::Evaluation e = gdsr::evaluate(d, {d.hr_frames[1], d.hr_frames[2]}, 1);
+  CHECK(e.mean.ssim_garment == doctest::Approx(1).epsilon(1e-6));
+  CHECK(e.mean.ssim_garment_lr < e.mean.ssim_lr);  // the background dilutes the difference
+  CHECK(e.frames[0].ssim_garment_scale < 0.999);
+  const cv::Mat mask = gdsr::garment_mask(d.raster);
+  int garment = 0;
+  for (size_t p = 0; p < d.raster.tri.size(); ++p) garment += d.raster.tri[p] >= 0;
+  CHECK(cv::countNonZero(mask) == garment);
+  CHECK(garment < d.raster.width * d.raster.height);
+}

@@ -49,7 +49,11 @@ TEST_CASE("report: tables plots images and video of a short roll-out") {
                         "images/normals_00007.png", "plots/energies.png", "rollout.avi", "0.012 + -"})
     CHECK_MESSAGE(md.find(s) != std::string::npos, s);
   char row[128];
-  std::snprintf(row, sizeof row, "| wave | %.4f | %.4f | %.4f |", e.mean.ssim_lr, e.mean.ssim, e.mean.ssim_scale);
+  std::snprintf(row, sizeof row, "| wave | whole map | %.4f | %.4f | %.4f |", e.mean.ssim_lr, e.mean.ssim,
+                e.mean.ssim_scale);
+  CHECK(md.find(row) != std::string::npos);
+  std::snprintf(row, sizeof row, "| wave | garment only | %.4f | %.4f | %.4f |", e.mean.ssim_garment_lr,
+                e.mean.ssim_garment, e.mean.ssim_garment_scale);
   CHECK(md.find(row) != std::string::npos);
   std::snprintf(row, sizeof row, "| HR at the LR scale | %.2f | %.2f | %.2f |", 1e3 * e.frames[0].error_scale,
                 1e3 * e.frames[6].error_scale, 1e3 * e.mean.error_scale);
@@ -75,6 +79,10 @@ TEST_CASE("report: tables plots images and video of a short roll-out") {
   CHECK(j["per_frame"].size() == 7);
   CHECK(j["per_frame"][2]["ssim"].get<double>() == doctest::Approx(e.frames[2].ssim));
   CHECK(j["per_frame"][2]["ssim_hr_lr_scale"].get<double>() == doctest::Approx(e.frames[2].ssim_scale));
+  CHECK(j["per_frame"][2]["ssim_garment_lr"].get<double>() == doctest::Approx(e.frames[2].ssim_garment_lr));
+  CHECK(j["mean"]["ssim_garment"].get<double>() == doctest::Approx(e.mean.ssim_garment));
+  const cv::Mat ssim_plot = cv::imread(dir / "r/plots/ssim.png");
+  CHECK(ssim_plot.rows == 2 * 280);  // whole map above, garment pixels below
   CHECK(j["mean"]["error_hr_lr_scale_m"].get<double>() == doctest::Approx(e.mean.error_scale));
   CHECK_FALSE(j["per_frame"][1].contains("ssim"));  // ssim_every 2
 
@@ -97,4 +105,7 @@ TEST_CASE("report: the error and SSIM plots draw the HR at the LR scale") {
   for (auto& f : moved.frames) f.error_scale *= 0.5, f.ssim_scale = 0.5 * (f.ssim_scale + f.ssim_lr);
   CHECK(cv::norm(gdsr::plot_error(e), gdsr::plot_error(moved), cv::NORM_L1) > 0);
   CHECK(cv::norm(gdsr::plot_ssim(e), gdsr::plot_ssim(moved), cv::NORM_L1) > 0);
+  gdsr::Evaluation garment_moved = e;  // the garment-pixel panel draws its own series
+  for (auto& f : garment_moved.frames) f.ssim_garment_scale = 0.5 * (f.ssim_garment_scale + f.ssim_garment_lr);
+  CHECK(cv::norm(gdsr::plot_ssim(e), gdsr::plot_ssim(garment_moved), cv::NORM_L1) > 0);
 }

@@ -155,3 +155,39 @@ TEST_CASE("patches: float64 gradient check of the normal map w.r.t. the patch's 
   INFO(r.report());
   CHECK(r.max_rel_error < 1e-6);
 }
+
+TEST_CASE("patches: validation's normal-map SSIM of a tilted flat patch is the closed form") {
+  // A flat garment against itself rotated by theta about x: the normal maps are uniform,
+  // (0.5, 0.5, 1) and (0.5, 0.5 - 0.5 sin theta, 0.5 + 0.5 cos theta), so on a patch the garment
+  // fills, every window is flat and SSIM = mean over channels of (2 a b + C1) / (a^2 + b^2 + C1),
+  // C1 = (0.01 * 255)^2 (Wang et al. 2004; the structure term is 1 on flat windows).
+  const GarmentMesh g = gdsr_test::cut_garment(31, 0.01);
+  PatchConfig cfg;
+  cfg.size = 40;
+  const PatchSampler s = make_sampler(g, 256, cfg);
+  std::vector<Patch> full;  // windows the garment fills
+  for (int y = 0; y + cfg.size <= 256 && full.size() < 2; y += 10)
+    for (int x = 0; x + cfg.size <= 256 && full.size() < 2; x += 10) {
+      Patch p = s.make_patch(x, y);
+      if (p.num_garment_pixels() == p.size * p.size) full.push_back(std::move(p));
+    }
+  REQUIRE(full.size() == 2);
+  const PatchBatch b = make_batch(full);
+  const double theta = 0.6;
+  Points3 flat(static_cast<int>(b.vertices.size()), 3), tilted = flat;
+  for (size_t i = 0; i < b.vertices.size(); ++i) {
+    const Vec3 x = g.V.row(b.vertices[i]).transpose();
+    flat.row(static_cast<int>(i)) = Vec3(x.x(), x.y(), 0).transpose();  // the sheet lies in z = 0
+    tilted.row(static_cast<int>(i)) = Vec3(x.x(), std::cos(theta) * x.y(), std::sin(theta) * x.y()).transpose();
+  }
+  const auto term = [](double a, double c) {
+    const double C1 = std::pow(0.01 * 255, 2);
+    a *= 255, c *= 255;
+    return (2 * a * c + C1) / (a * a + c * c + C1);
+  };
+  const double closed = (1 + term(0.5, 0.5 - 0.5 * std::sin(theta)) + term(1.0, 0.5 + 0.5 * std::cos(theta))) / 3;
+  CHECK(patch_normal_map_ssim(b, tilted, flat) == doctest::Approx(closed).epsilon(1e-5));  // float images
+  CHECK(patch_normal_map_ssim(b, flat, flat) == doctest::Approx(1).epsilon(1e-9));
+  CHECK(closed < 0.99);
+  CHECK_THROWS_AS(patch_normal_map_ssim(b, flat.topRows(3), flat), std::runtime_error);
+}

@@ -106,6 +106,11 @@ TEST_CASE("trainer: push-forward feeds the model its own history, and validation
   CHECK(std::isfinite(pushed[2].val_vertex_mm));
   CHECK(pushed[2].val_upsample_mm == teacher[2].val_upsample_mm);
   CHECK(pushed[2].val_upsample_mm > 0);
+  // The same patches' normal maps: SSIM over garment pixels, in (0, 1], the yardstick the same.
+  CHECK(pushed[2].val_ssim > 0);
+  CHECK(pushed[2].val_ssim <= 1);
+  CHECK(pushed[2].val_upsample_ssim == teacher[2].val_upsample_ssim);
+  CHECK(pushed[2].val_upsample_ssim < 1);
 }
 
 TEST_CASE("trainer: --detail-target changes only the fine terms of a step, not the coarse ones") {
