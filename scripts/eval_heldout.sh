@@ -2,7 +2,8 @@
 # Roll-out evaluation of one model on held-out datasets (issue #12): `gdsr infer` then
 # `gdsr eval` on each, then one table of GDSR against the upsampled LR input (vertex error,
 # normal-map SSIM over the whole UV map and over the garment's pixels only, mean stretch/shear
-# energies of the output), and the HR simulation at the LR scale (downsampled and upsampled: what a perfect correction E without detail would score).
+# energies of the output), and the HR simulation at the LR scale (downsampled and upsampled:
+# what a perfect correction E without detail would score).
 #   scripts/eval_heldout.sh BUILD_DIR MODEL OUT_DIR DATASET...
 # Example (the recipe's held-out clips):
 #   scripts/eval_heldout.sh build models/gdsr_small_skirt.ckpt runs/eval \
