@@ -150,6 +150,10 @@ void add_train_command(CLI::App& app) {
                  "push-forward: the history of a training frame is the model's own roll-out over the K frames "
                  "before it (0: the downsampled HR truth, teacher forcing)")
       ->capture_default_str();
+  c->add_option("--unroll", a->opt.unroll,
+                "train through a roll-out: each training frame's loss also covers the K-1 frames before it, "
+                "the history passed on with its gradient (1: off)")
+      ->capture_default_str();
   c->add_flag("--rollout-from-truth", a->opt.rollout_from_truth,
               "the push-forward roll-out starts from the downsampled HR truth before it, not from the LR input "
               "(with --rollout-history)");

@@ -24,6 +24,7 @@ nlohmann::json train_options_to_json(const TrainOptions& o) {
   j["frames_per_step"] = o.frames_per_step;
   j["rollout_history"] = o.rollout_history;
   j["rollout_from_truth"] = o.rollout_from_truth;
+  j["unroll"] = o.unroll;
   j["detail_target"] = o.detail_target;
   j["lr"] = o.lr;
   j["weight_decay"] = o.weight_decay;

@@ -189,6 +189,7 @@ std::string last_good(const TrainState& s) {
 
 struct FrameLoss {
   ag::Tensorf total;
+  ag::Tensorf C_hat_tensor;             // the corrected LR frame, with its gradient
   double coarse = 0, fine = 0;          // weighted parts
   std::map<std::string, double> terms;  // unweighted
   Points3 C_hat;                        // the corrected LR frame (the next frame's history in a roll-out)
@@ -205,10 +206,19 @@ double mean_distance_at(const Points3& predicted, const Points3& truth, const st
   return vertices.empty() ? 0.0 : sum / static_cast<double>(vertices.size());
 }
 
+// The coarse losses of frames before t in an unrolled step (train_step with opt.unroll > 1).
+struct EarlierCoarse {
+  ag::Tensorf sum;  // their coarse totals, summed
+  int frames = 0;
+};
+
 // Forward and losses of frame t of a sequence (noise and rng: training draws; nullptr noise
-// for validation).
+// for validation). history: the corrected history as tensors (values chat_tm1, chat_tm2) to
+// differentiate through; earlier: coarse losses of the unrolled frames before t, averaged
+// with frame t's into the coarse term.
 FrameLoss frame_loss(TrainState& s, Sequence& seq, int t, const Points3& chat_tm1, const Points3& chat_tm2,
-                     const Lambdas& lambdas, std::mt19937_64& rng, nn::Rng* noise, const TrainOptions& opt) {
+                     const Lambdas& lambdas, std::mt19937_64& rng, nn::Rng* noise, const TrainOptions& opt,
+                     const HistoryTensors<float>* history = nullptr, const EarlierCoarse* earlier = nullptr) {
   const Dataset& d = *seq.d;
   const FrameInput in = make_frame_input(d, t, chat_tm1, chat_tm2, seq.body.get());
   PatchBatch batch;
@@ -217,9 +227,14 @@ FrameLoss frame_loss(TrainState& s, Sequence& seq, int t, const Points3& chat_tm
     batch = seq.sampler->sample(rng);
     request = hr_request_subset(d.corr, batch.vertices);
   }
-  const GdsrOutput<float> out = s.model->forward(seq.graph, in, opt.fine ? &request : nullptr, noise);
+  const GdsrOutput<float> out = s.model->forward(seq.graph, in, opt.fine ? &request : nullptr, noise, nullptr, history);
   const CoarseLoss<float> coarse = coarse_loss(opt.loss, seq.lr_topo, out.C_hat, seq.lr_truth[t]);
+  const ag::Tensorf coarse_total =
+      earlier && earlier->frames > 0
+          ? ag::mul_scalar(ag::add(coarse.total, earlier->sum), 1.0f / static_cast<float>(earlier->frames + 1))
+          : coarse.total;
   FrameLoss f;
+  f.C_hat_tensor = out.C_hat;
   f.C_hat = gdsr::to_points(out.C_hat);
   FineLoss<float> fine;
   if (opt.fine) {
@@ -228,8 +243,8 @@ FrameLoss frame_loss(TrainState& s, Sequence& seq, int t, const Points3& chat_tm
                                              : Points3();
     fine = fine_loss(opt.loss, batch, out.G, opt.detail_target ? target : d.hr_frames[t], s.image_loss);
   }
-  f.total = total_loss(lambdas, coarse.total, fine.total);
-  f.coarse = lambdas.coarse * coarse.total.item();
+  f.total = total_loss(lambdas, coarse_total, fine.total);
+  f.coarse = lambdas.coarse * coarse_total.item();
   f.fine = fine.total.defined() ? lambdas.fine * fine.total.item() : 0.0;
   f.terms = coarse.log();                   // keys c_position, c_normal, ...
   if (opt.fine) f.terms.merge(fine.log());  // f_position, f_vgg, ...
@@ -342,6 +357,37 @@ void reduce_over_ranks(TrainState& s, TrainLog& L, GradientSum& sum, const Train
   if (!std::isfinite(L.loss)) gdsr::fail(at, "the weighted loss total is " + value_text(L.loss) + last_good(s));
 }
 
+// The loss of training frame t through a roll-out (opt.unroll > 1): frames t0 = max(t - unroll
+// + 1, 2) .. t are run with gradient, each one's corrected history being the outputs of the
+// frames before it as tensors, so the loss reaches back through the history. The history of
+// frame t0 is what it would be without unrolling (teacher forcing or push-forward).
+FrameLoss unrolled_loss(TrainState& s, Sequence& seq, int t, const Lambdas& lambdas, std::mt19937_64& rng,
+                        nn::Rng& noise, const TrainOptions& opt) {
+  const Dataset& d = *seq.d;
+  const int t0 = std::max(t - opt.unroll + 1, 2);
+  std::vector<Points3> pred;
+  int first = t0;
+  const std::vector<Points3>* before = &seq.lr_truth;  // teacher forcing
+  if (opt.rollout_history > 0) {
+    first = std::max(t0 - opt.rollout_history, 0);
+    before = opt.rollout_from_truth ? &seq.lr_truth : nullptr;
+    pred = corrected_rollout(*s.model, seq.graph, d, seq.body.get(), first, t0 - first, before);
+  }
+  Points3 h1 = rollout_history(d, pred, first, t0, 1, before), h2 = rollout_history(d, pred, first, t0, 2, before);
+  HistoryTensors<float> history{to_tensor<float>(h1), to_tensor<float>(h2)};
+  EarlierCoarse earlier;
+  for (int k = t0; k < t; ++k, ++earlier.frames) {
+    const FrameInput in = make_frame_input(d, k, h1, h2, seq.body.get());
+    const GdsrOutput<float> out = s.model->forward(seq.graph, in, nullptr, &noise, nullptr, &history);
+    const ag::Tensorf c = coarse_loss(opt.loss, seq.lr_topo, out.C_hat, seq.lr_truth[k]).total;
+    earlier.sum = earlier.frames == 0 ? c : ag::add(earlier.sum, c);
+    h2 = std::move(h1);
+    h1 = gdsr::to_points(out.C_hat);
+    history = HistoryTensors<float>{out.C_hat, history.Chat_tm1};
+  }
+  return frame_loss(s, seq, t, h1, h2, lambdas, rng, &noise, opt, &history, &earlier);
+}
+
 // One optimizer step on the next frames_per_step x ranks frames (this rank takes every
 // ranks-th one): forward, losses, finite checks, backward, the gradient sum, AdamW. Every
 // frame draws one seed from each main RNG stream for its patches and noise whichever rank
@@ -368,7 +414,9 @@ TrainLog train_step(TrainState& s, const TrainOptions& opt) {
     if (k % opt.ranks != opt.rank) continue;
     Sequence& seq = s.seqs[static_cast<size_t>(si)];
     FrameLoss f;
-    if (opt.rollout_history > 0) {  // push-forward: the history is the model's own, from a roll-out
+    if (opt.unroll > 1) {
+      f = unrolled_loss(s, seq, t, lambdas, patch_rng, noise, opt);
+    } else if (opt.rollout_history > 0) {  // push-forward: the history is the model's own, from a roll-out
       const int first = std::max(t - opt.rollout_history, 0);
       const std::vector<Points3>* before = opt.rollout_from_truth ? &seq.lr_truth : nullptr;
       const std::vector<Points3> pred =
@@ -526,6 +574,8 @@ void validate_train_options(const TrainOptions& opt) {
   if (opt.rollout_history < 0 || opt.rollout_history > 64)
     gdsr::fail("train", "--rollout-history must be 0 (teacher forcing) to 64 frames, got " +
                             std::to_string(opt.rollout_history));
+  if (opt.unroll < 1 || opt.unroll > 64)
+    gdsr::fail("train", "--unroll must be 1 (off) to 64 frames, got " + std::to_string(opt.unroll));
   if (opt.rollout_from_truth && opt.rollout_history == 0)
     gdsr::fail("train",
                "--rollout-from-truth needs --rollout-history K > 0 (without it the history is the truth already)");

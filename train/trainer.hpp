@@ -38,6 +38,12 @@ struct TrainOptions {
   // before t from the LR simulation as `gdsr infer` starts, so training sees the inputs a
   // roll-out feeds the model rather than the downsampled HR truth.
   int rollout_history = 0;
+  // Training through a roll-out (1: off): the loss of a training frame t also covers the
+  // unroll - 1 frames before it, each frame's corrected history being the previous frames'
+  // outputs with their gradient (backpropagation through time), so E learns to carry its own
+  // state; the history before those frames is as above. Coarse loss: the mean over the
+  // unrolled frames; fine loss on frame t only.
+  int unroll = 1;
   // Push-forward from the truth: the roll-out of rollout_history frames starts from the
   // downsampled HR truth before it (false: from the LR input, d = 0, as a roll-out's first frame).
   bool rollout_from_truth = false;

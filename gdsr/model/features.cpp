@@ -48,7 +48,8 @@ template <class T> ag::Tensor<T> layer_edge_features(const LayerEdges& le, const
 }
 
 template <class T> GraphFeatures<T> compute_features(const GarmentGraph& g, const ag::Tensor<T>& C_t,
-                                                     const FrameInput& in, const ModelConfig& cfg, nn::Rng* noise) {
+                                                     const FrameInput& in, const ModelConfig& cfg, nn::Rng* noise,
+                                                     const HistoryTensors<T>* history) {
   const int V = g.num_vertices;
   if (C_t.dim() != 2 || C_t.rows() != V || C_t.cols() != 3)
     gdsr::fail("features", "C_t tensor must be [" + std::to_string(V) + " x 3], got " + ag::shape_str(C_t.shape()));
@@ -89,14 +90,30 @@ template <class T> GraphFeatures<T> compute_features(const GarmentGraph& g, cons
     p_t = ag::Tensor<T>::zeros({V, 3});
   }
   const bool add_noise = noise != nullptr && cfg.noise_std > 0;
+  ag::Tensor<T> history_noise = ag::Tensor<T>::zeros({V, 6});  // d_tm1, vhat_tm1 columns (history only)
+  auto hn = history_noise.mat();
   for (int i = 0; i < V; ++i)
     for (int k = 0; k < 3; ++k) {
       double d = in.Chat_tm1(i, k) - in.C_tm1(i, k);
       double vh = in.Chat_tm1(i, k) - in.Chat_tm2(i, k);
-      if (add_noise) d += noise->normal(0.0, cfg.noise_std), vh += noise->normal(0.0, cfg.noise_std);
+      if (add_noise) {
+        const double nd = noise->normal(0.0, cfg.noise_std), nv = noise->normal(0.0, cfg.noise_std);
+        d += nd, vh += nv;
+        hn(i, k) = T(nd), hn(i, 3 + k) = T(nv);
+      }
       r(i, 4 + k) = T(d);
       r(i, 7 + k) = T(vh);
     }
+  if (history) {  // the same columns, differentiable in the history tensors
+    const auto shape_ok = [V](const ag::Tensor<T>& X) { return X.dim() == 2 && X.rows() == V && X.cols() == 3; };
+    if (!shape_ok(history->Chat_tm1) || !shape_ok(history->Chat_tm2))
+      gdsr::fail("features", "history tensors must be [" + std::to_string(V) + " x 3], got " +
+                                 ag::shape_str(history->Chat_tm1.shape()) + " and " +
+                                 ag::shape_str(history->Chat_tm2.shape()));
+    const ag::Tensor<T> d = ag::sub(history->Chat_tm1, to_tensor<T>(in.C_tm1));
+    const ag::Tensor<T> vh = ag::sub(history->Chat_tm1, history->Chat_tm2);
+    rest = ag::concat_cols<T>({ag::slice_cols(rest, 0, 4), ag::add(ag::concat_cols<T>({d, vh}), history_noise)});
+  }
   if (cfg.node_length_unit != 1.0) {
     const T s = T(1.0 / cfg.node_length_unit);
     out.node = ag::concat_cols<T>({n, ag::mul_scalar(vel, s), ag::mul_scalar(acc, s), ag::mul_scalar(m_t, s),
@@ -113,7 +130,7 @@ template <class T> GraphFeatures<T> compute_features(const GarmentGraph& g, cons
 
 #define INSTANTIATE(T)                                                                                        \
   template GraphFeatures<T> compute_features<T>(const GarmentGraph&, const ag::Tensor<T>&, const FrameInput&, \
-                                                const ModelConfig&, nn::Rng*);                                \
+                                                const ModelConfig&, nn::Rng*, const HistoryTensors<T>*);      \
   template ag::Tensor<T> layer_edge_features<T>(const LayerEdges&, const ag::Tensor<T>&, const Points3&, double);
 INSTANTIATE(float)
 INSTANTIATE(double)

@@ -40,14 +40,21 @@ template <class T> struct GraphFeatures {
   LayerEdges layer_edges;
 };
 
+// The corrected history C^_{t-1}, C^_{t-2} as tensors (V x 3 each, metres), for training
+// through a roll-out (`gdsr train --unroll`): the history features d_tm1 and vhat_tm1 are then
+// differentiable in them. Their values must be FrameInput's Chat_tm1 and Chat_tm2.
+template <class T> struct HistoryTensors { ag::Tensor<T> Chat_tm1, Chat_tm2; };
+
 // C_t: the positions at t as a tensor (may require grad; values must equal in.C_t).
 // Normals, velocity, acceleration, body magnitude/vector at t and the ring-1 edge
 // features at t are differentiable in C_t (body point and normal held fixed). noise:
 // when non-null and cfg.noise_std > 0, Gaussian noise of std noise_std (metres) is added
-// to the history features d_tm1 and vhat_tm1 (training only).
+// to the history features d_tm1 and vhat_tm1 (training only). history: when non-null, those
+// features are differentiable in its tensors (same values, same noise draws).
 template <class T> GraphFeatures<T> compute_features(const GarmentGraph& g, const ag::Tensor<T>& C_t,
                                                      const FrameInput& in, const ModelConfig& cfg,
-                                                     nn::Rng* noise = nullptr);
+                                                     nn::Rng* noise = nullptr,
+                                                     const HistoryTensors<T>* history = nullptr);
 
 // Layer-edge features only (EL x 9) for given directed pairs.
 template <class T>

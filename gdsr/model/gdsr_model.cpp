@@ -47,20 +47,24 @@ template <class T> GDSR<T>::GDSR(const ModelConfig& cfg) : cfg_(cfg) {
 }
 
 template <class T> GdsrOutput<T> GDSR<T>::forward(const GarmentGraph& g, const FrameInput& in, const HrRequest* hr,
-                                                  nn::Rng* noise, GdsrTimings* timings) const {
-  return forward(g, to_tensor<T>(in.C_t), in, hr, noise, timings);
+                                                  nn::Rng* noise, GdsrTimings* timings,
+                                                  const HistoryTensors<T>* history) const {
+  return forward(g, to_tensor<T>(in.C_t), in, hr, noise, timings, history);
 }
 
 template <class T> GdsrOutput<T> GDSR<T>::forward(const GarmentGraph& g, const ag::Tensor<T>& C_t, const FrameInput& in,
-                                                  const HrRequest* hr, nn::Rng* noise, GdsrTimings* timings) const {
+                                                  const HrRequest* hr, nn::Rng* noise, GdsrTimings* timings,
+                                                  const HistoryTensors<T>* history) const {
   auto t0 = Clock::now();
-  GraphFeatures<T> f = compute_features(g, C_t, in, cfg_, noise);
+  GraphFeatures<T> f = compute_features(g, C_t, in, cfg_, noise, history);
   if (timings) timings->features += since(t0);
   t0 = Clock::now();
   const ag::Tensor<T> z = h_->forward(g, f);
   if (timings) timings->h += since(t0);
   ag::Tensor<T> d_prev;  // the previous correction, for the carry only
-  if (cfg_.e_carry) d_prev = to_tensor<T>(Points3(in.Chat_tm1 - in.C_tm1));
+  if (cfg_.e_carry)
+    d_prev =
+        history ? ag::sub(history->Chat_tm1, to_tensor<T>(in.C_tm1)) : to_tensor<T>(Points3(in.Chat_tm1 - in.C_tm1));
   GdsrOutput<T> out = decode(g, C_t, z, hr, timings, cfg_.e_carry ? &d_prev : nullptr);
   out.features = std::move(f);
   return out;

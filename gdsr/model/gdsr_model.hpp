@@ -73,13 +73,15 @@ template <class T> class GDSR : public nn::Module<T> {
   explicit GDSR(const ModelConfig& cfg);
 
   // hr null: only C_hat (A is not run). noise non-null: training noise on the history
-  // features (ModelConfig::noise_std).
+  // features (ModelConfig::noise_std). history non-null: the output is differentiable in the
+  // corrected history too (training through a roll-out; features.hpp).
   GdsrOutput<T> forward(const GarmentGraph& g, const FrameInput& in, const HrRequest* hr, nn::Rng* noise = nullptr,
-                        GdsrTimings* timings = nullptr) const;
+                        GdsrTimings* timings = nullptr, const HistoryTensors<T>* history = nullptr) const;
   // Same with the positions at t given as a tensor (values must equal in.C_t), e.g. a leaf
   // requiring grad to differentiate with respect to C.
   GdsrOutput<T> forward(const GarmentGraph& g, const ag::Tensor<T>& C_t, const FrameInput& in, const HrRequest* hr,
-                        nn::Rng* noise = nullptr, GdsrTimings* timings = nullptr) const;
+                        nn::Rng* noise = nullptr, GdsrTimings* timings = nullptr,
+                        const HistoryTensors<T>* history = nullptr) const;
   // E and A (and the composition) for a given latent z [V x (z_detail + z_disp)]; d_prev
   // [V x 3]: the previous correction C^_{t-1} - C_{t-1}, used by the carry (ModelConfig::e_carry).
   GdsrOutput<T> decode(const GarmentGraph& g, const ag::Tensor<T>& C_t, const ag::Tensor<T>& z, const HrRequest* hr,

@@ -129,7 +129,7 @@ TEST_CASE("cli train: the run folder holds the CSV log and loss curves and confi
   const std::string out = dir / "run";
   const Run r = gdsr_run(dir, "train --data '" + data + "' --val-data '" + data + "' --config '" + GDSR_SOURCE_DIR +
                                   "/configs/tiny.json' --no-vgg --patches 2 --patch-size 32 --epochs 4 " +
-                                  "--frames-per-step 2 --checkpoint-every 3 --out '" + out + "'");
+                                  "--frames-per-step 2 --checkpoint-every 3 --unroll 2 --out '" + out + "'");
   REQUIRE(r.status == 0);
   const std::vector<std::string> rows = csv_rows(out + "/train_log.csv");
   REQUIRE(rows.size() == 12);  // 24 frames, 2 per step
@@ -156,6 +156,7 @@ TEST_CASE("cli train: the run folder holds the CSV log and loss curves and confi
   CHECK(fs::exists(out + "/model.best.ckpt"));
   const nlohmann::json cfg = nlohmann::json::parse(slurp(out + "/config.json"));
   CHECK(cfg.at("frames_per_step") == 2);
+  CHECK(cfg.at("unroll") == 2);
   CHECK(cfg.at("model").at("mp_steps") == 2);  // the preset's values, not its file name alone
   CHECK(cfg.at("loss").at("coarse").at("smooth").at("weight") == 100.0);
   CHECK(cfg.at("command").at("val_data").size() == 1);
@@ -199,6 +200,7 @@ TEST_CASE("cli train: bad flags and files give a one-line error and write nothin
   check_one_line_error(gdsr_run(dir, base + " --lr nan"), "--lr must be finite");
   check_one_line_error(gdsr_run(dir, base + " --lr -1"), "--lr must be finite");
   check_one_line_error(gdsr_run(dir, base + " --frames-per-step 0"), "--frames-per-step must be positive");
+  check_one_line_error(gdsr_run(dir, base + " --unroll 0"), "--unroll must be 1 (off) to 64");
   check_one_line_error(gdsr_run(dir, base + " --epochs x"), "--epochs");
   {
     std::ofstream(dir / "neg.json") << R"({"coarse": {"smooth": {"weight": -1}}})";
