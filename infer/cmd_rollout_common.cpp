@@ -97,6 +97,7 @@ gdsr::Prediction to_prediction(const RolloutArgs& a, gdsr::RolloutResult r) {
   p.dataset = input_id(a);
   p.model = a.model;
   for (const std::string& part : a.ablate) p.model += " (" + part + " off)";
+  if (a.opt.true_history) p.model += " (true history)";
   p.seconds_per_frame = r.seconds_per_frame;
   p.model_seconds_per_frame = r.model_seconds_per_frame;
   return p;
@@ -135,6 +136,9 @@ void add_rollout_options(CLI::App* c, RolloutArgs& a, bool data_required) {
                 "switch a part of the model off (repeatable): correction (C^ = C, no E) or detail (G = upsampled "
                 "C^, no A)")
       ->check(CLI::IsMember({"correction", "detail"}));
+  c->add_flag("--true-history", a.opt.true_history,
+              "feed each frame the HR simulation downsampled to the LR mesh as its history instead of the model's "
+              "own output (teacher forcing): how much the model gains when its history is right");
 }
 
 void add_sequence_options(CLI::App* c, RolloutArgs& a) {

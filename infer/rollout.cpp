@@ -23,6 +23,15 @@ RolloutResult rollout(const GDSR<float>& model, const Dataset& d, const RolloutO
     gdsr::fail("--frames", std::to_string(opt.frames) + " from frame " + std::to_string(opt.first_frame) +
                                " runs past the input's " + std::to_string(T) + " frames");
   const int count = opt.frames < 0 ? T - opt.first_frame : opt.frames;
+  std::vector<Points3> truth;  // the downsampled HR frames, for opt.true_history
+  if (opt.true_history) {
+    if (d.hr_frames.size() != d.lr_frames.size())
+      gdsr::fail("--true-history", "needs the input's HR simulation (a dataset's hr_frames); this input has " +
+                                       std::to_string(d.hr_frames.size()) + " HR frames for " + std::to_string(T) +
+                                       " LR frames");
+    for (const Points3& hr : d.hr_frames) truth.push_back(downsample(d.corr, hr));
+  }
+  const std::vector<Points3> none;
   ag::NoGradGuard no_grad;
   const GarmentGraph graph = build_graph(d.lr);
   const HrRequest all = hr_request_all(d.corr);
@@ -34,8 +43,11 @@ RolloutResult rollout(const GDSR<float>& model, const Dataset& d, const RolloutO
   const auto start = std::chrono::steady_clock::now();
   for (int k = 0; k < count; ++k) {
     const int t = opt.first_frame + k;
-    const FrameInput in = make_frame_input(d, t, rollout_history(d, r.C_hat, opt.first_frame, t, 1),
-                                           rollout_history(d, r.C_hat, opt.first_frame, t, 2), body.get());
+    const FrameInput in = opt.true_history
+                              ? make_frame_input(d, t, rollout_history(d, none, t, t, 1, &truth),
+                                                 rollout_history(d, none, t, t, 2, &truth), body.get())
+                              : make_frame_input(d, t, rollout_history(d, r.C_hat, opt.first_frame, t, 1),
+                                                 rollout_history(d, r.C_hat, opt.first_frame, t, 2), body.get());
     const auto m0 = std::chrono::steady_clock::now();
     const GdsrOutput<float> out = model.forward(graph, in, &all);
     model_secs += std::chrono::duration<double>(std::chrono::steady_clock::now() - m0).count();

@@ -18,6 +18,10 @@ struct RolloutOptions {
   int frames = -1;         // < 0: to the end of the sequence
   bool collisions = true;  // section 4.6 post-process
   CollisionConfig collision;
+  // Each frame's history C^_{t-1}, C^_{t-2} is the dataset's HR simulation downsampled to the
+  // LR mesh (training's teacher forcing) instead of the model's own output: what the model
+  // scores when its history is right, beside what it scores on its own. Needs HR frames.
+  bool true_history = false;
 };
 
 struct RolloutResult {

@@ -307,6 +307,9 @@ std::vector<Case> corpus() {
       {kInfer + "{d}/ds --layer-offset 0.5", "--layer-offset"},
       {kInfer + "{d}/missing", "missing"},
       {kInfer + "{d}/ds --lr-dir {d}/exp_md/lr", "--lr-dir"},
+      {"infer --model {d}/run/model.ckpt --out {d}/pred --subdivide 1 --lr-dir {d}/exp_md/lr "
+       "--lr-uv {d}/exp_md/lr_flat.obj --true-history",
+       "--true-history"},  // an own sequence has no HR simulation
       {"infer --model {d}/run/model.ckpt --out {d}/pred", "--data"},
       {"infer --model {d}/run/model.ckpt --data {d}/ds --out {d}/p.png", "p.png"},
       // ---- infer on an own OBJ sequence

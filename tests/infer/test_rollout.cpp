@@ -115,3 +115,29 @@ TEST_CASE("rollout: the mean moves of E and A are |C^ - C| and |G - upsampled C^
   CHECK(none.mean_correction == 0.0);
   CHECK(none.mean_detail == 0.0);
 }
+
+TEST_CASE("rollout: --true-history feeds every frame the downsampled HR simulation as its history") {
+  const gdsr::Dataset d = gdsr_test::wave_dataset(7);
+  const gdsr::GDSR<float> model(gdsr::load_model_config(std::string(GDSR_SOURCE_DIR) + "/configs/tiny.json"));
+  const gdsr::GarmentGraph g = gdsr::build_graph(d.lr);
+  gdsr::RolloutOptions o;
+  o.collisions = false;
+  o.first_frame = 2;
+  const gdsr::RolloutResult own = gdsr::rollout(model, d, o);
+  o.true_history = true;
+  const gdsr::RolloutResult taught = gdsr::rollout(model, d, o);
+  REQUIRE(taught.C_hat.size() == 5);
+  std::vector<gdsr::Points3> truth;
+  for (const auto& hr : d.hr_frames) truth.push_back(gdsr::downsample(d.corr, hr));
+  for (int k = 0; k < 5; ++k) {
+    CAPTURE(k);
+    const int t = 2 + k;
+    const gdsr::FrameInput in = gdsr::make_frame_input(d, t, truth[t - 1], truth[t - 2], nullptr);
+    CHECK((taught.C_hat[k] - gdsr::to_points(model.forward(g, in, nullptr).C_hat)).cwiseAbs().maxCoeff() == 0.0);
+    CHECK((taught.C_hat[k] - own.C_hat[k]).cwiseAbs().maxCoeff() > 0.0);  // the model's own history differs
+  }
+  gdsr::Dataset no_hr = d;  // an own LR sequence has no HR frames
+  no_hr.hr_frames.clear();
+  CHECK_THROWS_WITH_AS(gdsr::rollout(model, no_hr, o), doctest::Contains("--true-history: needs the input's HR"),
+                       std::runtime_error);
+}
