@@ -43,11 +43,12 @@ RolloutResult rollout(const GDSR<float>& model, const Dataset& d, const RolloutO
   const auto start = std::chrono::steady_clock::now();
   for (int k = 0; k < count; ++k) {
     const int t = opt.first_frame + k;
-    const FrameInput in = opt.true_history
-                              ? make_frame_input(d, t, rollout_history(d, none, t, t, 1, &truth),
-                                                 rollout_history(d, none, t, t, 2, &truth), body.get())
-                              : make_frame_input(d, t, rollout_history(d, r.C_hat, opt.first_frame, t, 1),
-                                                 rollout_history(d, r.C_hat, opt.first_frame, t, 2), body.get());
+    // True history: no prediction before t, so both frames come from the downsampled truth.
+    const std::vector<Points3>& pred = opt.true_history ? none : r.C_hat;
+    const int first = opt.true_history ? t : opt.first_frame;
+    const std::vector<Points3>* before = opt.true_history ? &truth : nullptr;
+    const FrameInput in = make_frame_input(d, t, rollout_history(d, pred, first, t, 1, before),
+                                           rollout_history(d, pred, first, t, 2, before), body.get());
     const auto m0 = std::chrono::steady_clock::now();
     const GdsrOutput<float> out = model.forward(graph, in, &all);
     model_secs += std::chrono::duration<double>(std::chrono::steady_clock::now() - m0).count();

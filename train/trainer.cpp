@@ -189,7 +189,6 @@ std::string last_good(const TrainState& s) {
 
 struct FrameLoss {
   ag::Tensorf total;
-  ag::Tensorf C_hat_tensor;             // the corrected LR frame, with its gradient
   double coarse = 0, fine = 0;          // weighted parts
   std::map<std::string, double> terms;  // unweighted
   Points3 C_hat;                        // the corrected LR frame (the next frame's history in a roll-out)
@@ -234,7 +233,6 @@ FrameLoss frame_loss(TrainState& s, Sequence& seq, int t, const Points3& chat_tm
           ? ag::mul_scalar(ag::add(coarse.total, earlier->sum), 1.0f / static_cast<float>(earlier->frames + 1))
           : coarse.total;
   FrameLoss f;
-  f.C_hat_tensor = out.C_hat;
   f.C_hat = gdsr::to_points(out.C_hat);
   FineLoss<float> fine;
   if (opt.fine) {

@@ -90,8 +90,8 @@ template <class T> GraphFeatures<T> compute_features(const GarmentGraph& g, cons
     p_t = ag::Tensor<T>::zeros({V, 3});
   }
   const bool add_noise = noise != nullptr && cfg.noise_std > 0;
-  ag::Tensor<T> history_noise = ag::Tensor<T>::zeros({V, 6});  // d_tm1, vhat_tm1 columns (history only)
-  auto hn = history_noise.mat();
+  // With history tensors, the noise drawn here is kept to add to their columns below.
+  ag::Tensor<T> history_noise = history ? ag::Tensor<T>::zeros({V, 6}) : ag::Tensor<T>();
   for (int i = 0; i < V; ++i)
     for (int k = 0; k < 3; ++k) {
       double d = in.Chat_tm1(i, k) - in.C_tm1(i, k);
@@ -99,7 +99,7 @@ template <class T> GraphFeatures<T> compute_features(const GarmentGraph& g, cons
       if (add_noise) {
         const double nd = noise->normal(0.0, cfg.noise_std), nv = noise->normal(0.0, cfg.noise_std);
         d += nd, vh += nv;
-        hn(i, k) = T(nd), hn(i, 3 + k) = T(nv);
+        if (history) history_noise.mat()(i, k) = T(nd), history_noise.mat()(i, 3 + k) = T(nv);
       }
       r(i, 4 + k) = T(d);
       r(i, 7 + k) = T(vh);
