@@ -46,6 +46,14 @@
 #   of self-intersections 100 -> 25.7%), 0.25 98 / 39 / 0.0031; all within the friction spread
 #   (--friction 0.30001: 91 / 35 / 0.0039):
 #     bench/sim_sweep.sh build OUT --contact-every "5 1" tshirt ../shared/motions/cmu-salsa/61_03.bvh 2 4 "--hr-pd 0.03"
+# - the same clip at revision 29, where the elbow crook's cloth was down to a stale contact plane:
+#   body contacts refreshed every 5 / 3 / 2 / 1 substeps, frames with cloth > 5 mm inside the body
+#   outside pinches 23 / 2 / 2 / 2 at 0.064 / 0.066 / 0.074 / 0.095 s a frame (LR); 3 is the
+#   t-shirt's since then (sim::body_contact_every; 5 knots loose pants and skirts less). With the
+#   friction nudged by 1e-5 to 6e-5, 5: 6-23 frames in 6 runs, 3: 0-3 in 6; one of those 6 at 3
+#   crossed itself from frame 96 in an armpit fold pressed onto the body (70.6% of LR frames free of
+#   self-intersections), none of the 6 at 5:
+#     bench/sim_sweep.sh build OUT --contact-every "5 3 2 1" tshirt ../shared/motions/cmu-salsa/61_03.bvh 2 4 "--hr-pd 0.03"
 set -e
 usage="usage: $0 BUILD_DIR OUT_DIR OPTION VALUES [GARMENT] [MOTION] [START_S] [SECONDS] [FLAGS]"
 build=$(cd "${1:?$usage}" && pwd)

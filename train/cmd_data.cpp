@@ -106,6 +106,11 @@ double effective_track_rate(const MakeArgs& a) {
   return std::isnan(a.track_rate) ? sim::SimParams().track_rate : a.track_rate;
 }
 
+// Substeps between body contact refreshes in effect (--contact-every, else the garment's).
+int effective_contact_every(const MakeArgs& a) {
+  return a.contact_every > 0 ? a.contact_every : sim::body_contact_every(a.garment, sim::SimParams().contact_every);
+}
+
 struct SimRun {
   sim::Garment garment;
   std::vector<gdsr::Points3> frames;
@@ -204,7 +209,7 @@ void run_make(const MakeArgs& a) {
   if (a.iterations > 0) params.iterations = a.iterations;
   if (a.stretch_passes > 0) params.stretch_passes = a.stretch_passes;
   if (a.settle_frames >= 0) params.settle_frames = a.settle_frames;
-  if (a.contact_every > 0) params.contact_every = a.contact_every;
+  params.contact_every = effective_contact_every(a);
   if (!std::isnan(a.contact_travel)) params.contact_travel = a.contact_travel;
   if (!std::isnan(a.pin_yield_rate)) params.pin_yield_rate = a.pin_yield_rate;
   if (!std::isnan(a.friction)) params.friction = a.friction;
@@ -360,6 +365,10 @@ bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why
     }
     if (!same(sp.value("arm_clearance_m", 0.0), a.arm_clearance)) {
       why = "built with another arm clearance";
+      return false;
+    }
+    if (sp.value("contact_every", 0) != effective_contact_every(a)) {
+      why = "built with another body contact refresh";
       return false;
     }
     if (sp.value("hr_start", "") != hr_start_name(a)) {
@@ -798,7 +807,8 @@ void add_data_command(CLI::App& app) {
                    "and adds finer wrinkles (default: the solver's, 30; 0: independent, as before revision 13)")
       ->check(finite_range(0.0, 1000.0));
   make->add_option("--contact-every", mk->contact_every,
-                   "substeps between body contact refreshes (default: the solver's)")
+                   "substeps between body contact refreshes (default: the garment's, 3 for the t-shirt, "
+                   "else the solver's, 5)")
       ->check(CLI::Range(1, 1000));
   make->add_option(
           "--contact-travel", mk->contact_travel,

@@ -271,7 +271,8 @@ struct SimParams {
   gdsr::Vec3 gravity = gdsr::Vec3(0, -9.81, 0);  // m/s^2
   double layer_gap = 0.004;                      // m, outer layer kept this far outside the inner layer
   double contact_radius = 0.03;                  // m, body search radius beyond thickness
-  int contact_every = 5;                         // substeps between contact refreshes
+  int contact_every = 5;                         // substeps between contact refreshes (3 for the t-shirt's sleeves in a
+                                                 // bending elbow, sim::body_contact_every in garments.hpp)
   double contact_travel = 1;  // the contact search reaches beyond thickness + contact_radius by this many times the
                               // distance the vertex travels (its speed) until the next refresh, for a surface it
                               // approaches fast enough to come within that radius by then: cloth that covered the

@@ -15,6 +15,7 @@ struct CatalogueEntry {
   const char* name;
   GarmentDesign (*design)(const BodyLandmarks&);
   double rest_arm_drop_degrees = -1;  // see rest_arm_drop_degrees()
+  int body_contact_every = 0;         // see body_contact_every(); 0: the solver's default
 };
 
 // The garment catalogue: the one place a garment's name is looked up.
@@ -25,7 +26,7 @@ const CatalogueEntry kCatalogue[] = {
     {"shorts", design_shorts},
     {"skirt_layered", design_skirt_layered},
     // The paper's five training garment types.
-    {"tshirt", design_tshirt, 45},
+    {"tshirt", design_tshirt, 45, 3},
     {"pants", design_pants},
     {"skirt_pleated", design_skirt_pleated},
     {"dress_layered", design_dress_layered},
@@ -51,6 +52,11 @@ std::vector<std::string> garment_names() {
 }
 
 double rest_arm_drop_degrees(const std::string& name) { return entry(name).rest_arm_drop_degrees; }
+
+int body_contact_every(const std::string& name, int solver_default) {
+  const int every = entry(name).body_contact_every;
+  return every > 0 ? every : solver_default;
+}
 
 Pattern garment_pattern(const std::string& name, const BodyLandmarks& lm) { return design(name, lm).pattern; }
 

@@ -304,6 +304,24 @@ TEST_CASE("cli data: --skip-built keeps a clip built by this solver revision and
   CHECK(as_file.out.find("built with another arm clearance") != std::string::npos);
   CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"arm_clearance_m\": 0.0") != std::string::npos);
   CHECK(gdsr_run(dir, cmd + " --arm-clearance -1").status != 0);
+  // And the body contact refresh: the skirt's is the solver's, 5, unless asked otherwise.
+  CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"contact_every\": 5") != std::string::npos);
+  const Run refresh = gdsr_run(dir, cmd + " --start 0.1 --independent-hr --arm-clearance 0 --contact-every 3");
+  REQUIRE(refresh.status == 0);
+  CHECK(refresh.out.find("built with another body contact refresh") != std::string::npos);
+  CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"contact_every\": 3") != std::string::npos);
+}
+
+TEST_CASE("cli data: the t-shirt is simulated with its own body contact refresh, every 3rd substep") {
+  // sim::body_contact_every: the sleeve in a bending elbow's crook needs fresher contacts.
+  TempDir dir("cli_tshirt_refresh");
+  const std::string out = dir / "ds";
+  const Run mk =
+      gdsr_run(dir, "data make --garment tshirt --motion '" + std::string(GDSR_SHARED_DIR) +
+                        "/motions/cmu-salsa/61_03.bvh' --start 2 --out '" + out +
+                        "' --seconds 0.1 --lr-pd 0.06 --hr-pd 0.05 --rest-blend 2 --raster 64 --settle-frames 3");
+  REQUIRE(mk.status == 0);
+  CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"contact_every\": 3") != std::string::npos);
 }
 
 TEST_CASE("cli data: compare finds a repeat bit-identical, a nudged twin apart, and refuses other meshes") {
