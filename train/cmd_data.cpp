@@ -807,8 +807,9 @@ void add_data_command(CLI::App& app) {
                    "and adds finer wrinkles (default: the solver's, 30; 0: independent, as before revision 13)")
       ->check(finite_range(0.0, 1000.0));
   make->add_option("--contact-every", mk->contact_every,
-                   "substeps between body contact refreshes (default: the garment's, 3 for the t-shirt, "
-                   "else the solver's, 5)")
+                   "substeps between body contact refreshes (default: the garment's, " +
+                       std::to_string(sim::body_contact_every("tshirt", sim::SimParams().contact_every)) +
+                       " for the t-shirt, else the solver's, " + std::to_string(sim::SimParams().contact_every) + ")")
       ->check(CLI::Range(1, 1000));
   make->add_option(
           "--contact-travel", mk->contact_travel,
