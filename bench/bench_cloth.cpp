@@ -4,7 +4,8 @@
 // settings (slack: how far a vertex may leave its predicted path before re-detection; detect:
 // substeps between detections; thick: the self-contact thickness; contact_every: substeps
 // between body contact refreshes; redetect: only the pairs of a vertex that left its slack are
-// found again, or all), with and without
+// found again, or all; retest: the tangle test also after a substep that pushed pairs back
+// across, or once a frame), with and without
 // self-collision. Every setting starts from
 // the drape `gdsr data make` starts its clip from (the first pose's settle with the default
 // solver, HR from the upsampled LR drape), so the figures are those of a dataset, and the
@@ -94,9 +95,10 @@ const gdsr::Points3& start(int mm) {
 // solver before revision 8); thickness_m > 0: that self-contact thickness; 0: the solver's defaults.
 std::vector<gdsr::Points3> run(int mm, int substeps, int iterations, bool self_collision, double slack_m = 0,
                                int detect_every = 0, double thickness_m = 0, int contact_every = 0,
-                               bool redetect = true) {
+                               bool redetect = true, bool retest = false) {
   sim::SimParams p;
   p.self_redetect = redetect;
+  p.self_tangle_retest = retest;
   p.substeps = substeps;
   p.iterations = iterations;
   p.self_collision = self_collision;
@@ -128,6 +130,7 @@ void BM_ClothSkirtShort(benchmark::State& state) {
   const double thickness = state.range(6) * 1e-4;  // 0.1 mm units
   const int contact_every = static_cast<int>(state.range(7));  // 0: the solver's
   const bool redetect = state.range(8) != 0;
+  const bool retest = state.range(9) != 0;
   const auto& sc = scene();
   const auto& g = garment(mm);
   const auto& ref = reference(mm);
@@ -136,7 +139,8 @@ void BM_ClothSkirtShort(benchmark::State& state) {
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::clock_t c0 = std::clock();
-    out = run(mm, substeps, iterations, self_collision, slack, detect_every, thickness, contact_every, redetect);
+    out =
+        run(mm, substeps, iterations, self_collision, slack, detect_every, thickness, contact_every, redetect, retest);
     cpu += static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
@@ -174,18 +178,19 @@ void BM_ClothSkirtShort(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_ClothSkirtShort)
-    ->Args({30, 40, 1, 0, 0, 0, 0, 0, 1})  // the former default: no self-collision, one pass
-    ->Args({30, 20, 2, 1, 0, 0, 0, 0, 1})  // the default
-    ->Args({30, 10, 2, 1, 0, 0, 0, 0, 1})
-    ->Args({30, 20, 4, 1, 0, 0, 0, 0, 1})
-    ->Args({10, 40, 1, 0, 0, 0, 0, 0, 1})
-    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 1})  // the default: slack 1.5 mm, detected at most every 8 substeps, 5 mm thick
-    ->Args({10, 10, 2, 1, 0, 0, 0, 0, 1})
+    ->Args({30, 40, 1, 0, 0, 0, 0, 0, 1, 0})  // the former default: no self-collision, one pass
+    ->Args({30, 20, 2, 1, 0, 0, 0, 0, 1, 0})  // the default
+    ->Args({30, 10, 2, 1, 0, 0, 0, 0, 1, 0})
+    ->Args({30, 20, 4, 1, 0, 0, 0, 0, 1, 0})
+    ->Args({10, 40, 1, 0, 0, 0, 0, 0, 1, 0})
+    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 1,
+            0})  // the default: slack 1.5 mm, detected at most every 8 substeps, 5 mm thick
+    ->Args({10, 10, 2, 1, 0, 0, 0, 0, 1, 0})
     // The 10 mm default before solver revision 8: the 30 mm mesh's 3 mm slack, detected at most
     // every 4 substeps. The same figures in 1.7x the time (SimParams::self_slack_per_pd).
-    ->Args({10, 20, 2, 1, 30, 4, 0, 0, 1})
+    ->Args({10, 20, 2, 1, 30, 4, 0, 0, 1, 0})
     // The 10 mm default before solver revision 18: 3 mm thick (SimParams::self_thickness).
-    ->Args({10, 20, 2, 1, 0, 0, 30, 0, 1})
+    ->Args({10, 20, 2, 1, 0, 0, 30, 0, 1, 0})
     // Body contacts found every substep instead of every 5th (SimParams::contact_every): a fast
     // limb cannot overtake the cloth between two refreshes. On this walk: 1.8x (30 mm) and 1.4x
     // (10 mm) the CPU time for the same figures (no penetration either way, RMS from the
@@ -193,16 +198,20 @@ BENCHMARK(BM_ClothSkirtShort)
     // the t-shirt's (sim::body_contact_every, for its sleeves in a bending elbow's crook); on this
     // walk 1.07x the CPU time at both 30 mm (0.050 s a frame) and 10 mm (0.66 s), the same figures
     // (RMS from the reference 15.9 and 28.8 mm, every 4th frame free of self-intersections).
-    ->Args({30, 20, 2, 1, 0, 0, 0, 1, 1})
-    ->Args({10, 20, 2, 1, 0, 0, 0, 1, 1})
-    ->Args({30, 20, 2, 1, 0, 0, 0, 3, 1})
-    ->Args({10, 20, 2, 1, 0, 0, 0, 3, 1})
+    ->Args({30, 20, 2, 1, 0, 0, 0, 1, 1, 0})
+    ->Args({10, 20, 2, 1, 0, 0, 0, 1, 1, 0})
+    ->Args({30, 20, 2, 1, 0, 0, 0, 3, 1, 0})
+    ->Args({10, 20, 2, 1, 0, 0, 0, 3, 1, 0})
     // A full detection whenever a vertex leaves its slack, as before solver revision 22, instead
     // of finding only its pairs again (SimParams::self_redetect).
-    ->Args({30, 20, 2, 1, 0, 0, 0, 0, 0})
-    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 0})
+    ->Args({30, 20, 2, 1, 0, 0, 0, 0, 0, 0})
+    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 0, 0})
+    // The tangle test also after a substep that pushed pairs back across, not only once a frame
+    // (SimParams::self_tangle_retest, off by default).
+    ->Args({30, 20, 2, 1, 0, 0, 0, 0, 1, 1})
+    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 1, 1})
     ->ArgNames({"mm", "substeps", "iterations", "self", "slack_0.1mm", "detect", "thick_0.1mm", "contact_every",
-                "redetect"})
+                "redetect", "retest"})
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
 

@@ -79,6 +79,7 @@ struct MakeArgs {
   bool limbs_pass_through = true;
   bool limbs_pass_until_clear = true;
   bool self_redetect = true;
+  bool self_tangle_retest = false;
   bool independent_hr = false;  // settle HR from its own placement, not from the settled LR garment
   bool skip_built = false;      // keep --out when it already holds this clip, built and valid
   int rest_blend_frames = 15;
@@ -230,6 +231,7 @@ void run_make(const MakeArgs& a) {
   params.limbs_pass_through = a.limbs_pass_through;
   params.limbs_pass_until_clear = a.limbs_pass_until_clear;
   params.self_redetect = a.self_redetect;
+  params.self_tangle_retest = a.self_tangle_retest;
   sim::Garment lr_garment = sim::make_garment(a.garment, a.lr_pd, body.rest_mesh());
   sim::Garment hr_garment = sim::make_garment(a.garment, a.hr_pd, body.rest_mesh());
   gdsr::Dataset d;
@@ -297,6 +299,7 @@ void run_make(const MakeArgs& a) {
                   {"self_passes", params.self_passes},
                   {"self_crossed_push", params.self_crossed_push},
                   {"self_redetect", params.self_redetect},
+                  {"self_tangle_retest", params.self_tangle_retest},
                   {"untangle_step", params.untangle_step},
                   {"hr_track_rate_1_s", params.track_rate},
                   {"compression_ratio", params.compression_ratio},
@@ -369,6 +372,10 @@ bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why
     }
     if (sp.value("contact_every", 0) != effective_contact_every(a)) {
       why = "built with another body contact refresh";
+      return false;
+    }
+    if (sp.value("self_tangle_retest", false) != a.self_tangle_retest) {
+      why = "built with another tangle test cue";
       return false;
     }
     if (sp.value("hr_start", "") != hr_start_name(a)) {
@@ -827,6 +834,9 @@ void add_data_command(CLI::App& app) {
   make->add_flag("!--no-self-redetect", mk->self_redetect,
                  "find every self-contact pair again whenever a vertex leaves its slack, not only that vertex's "
                  "(solver revision 21; slower, the same pairs where it matters)");
+  make->add_flag("--tangle-retest", mk->self_tangle_retest,
+                 "look for cloth through itself also after a substep whose self-contact pass pushed pairs back "
+                 "across, not only once a frame (sim::SimParams::self_tangle_retest has the trade)");
   make->add_flag("!--no-limbs-pass-through", mk->limbs_pass_through,
                  "keep body contacts around cloth that a hand went through, so the hand carries it (solver "
                  "revision 10)");

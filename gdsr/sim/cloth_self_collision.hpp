@@ -104,6 +104,8 @@ class SelfCollision {
   // `step` metres. Returns the number of crossings that were still crossing.
   int untangle(gdsr::Points3& x, const std::vector<double>& winv, double step);
 
+  // Pairs the last project() pushed back from the other side of their remembered one.
+  int num_crossed_pushed() const { return crossed_pushed_; }
   int num_vertex_triangle() const { return static_cast<int>(vt_.size()); }
   int num_edge_edge() const { return static_cast<int>(ee_.size()); }
   // Vertices of edges and triangles found crossing each other at the last tangle test.
@@ -162,13 +164,14 @@ class SelfCollision {
   struct PairPush {
     int v[4];
     gdsr::Vec3 d[4];
+    bool crossed;  // the pair was on the other side from its remembered one
     void apply(gdsr::Points3& x) const {
       for (int k = 0; k < 4; ++k) x.row(v[k]) += d[k].transpose();
     }
   };
   bool project_pair(const gdsr::Points3& x, const ProjectLimits& l, VT& c, PairPush& out) const;
   bool project_pair(const gdsr::Points3& x, const ProjectLimits& l, EE& c, PairPush& out) const;
-  template <class Pair> int project_in_order(gdsr::Points3& x, const ProjectLimits& l, std::vector<Pair>& pairs) const;
+  template <class Pair> int project_in_order(gdsr::Points3& x, const ProjectLimits& l, std::vector<Pair>& pairs);
   // The second phase (see the .cpp): `evaluated` and `pushes` hold the first phase's pairs and
   // verdicts; `pairs` gets the pass's. moved_*: the vertices, faces and edges pushed so far this
   // pass. `redone` counts the pairs evaluated again.
@@ -193,6 +196,7 @@ class SelfCollision {
   double last_redone_share_ = 0;           // of the pairs, by the last two-phase pass
   int passes_in_order_ = 0;                // since then
   int intersecting_ = 0;
+  int crossed_pushed_ = 0;
   long long detections_ = 0;
   long long redetections_ = 0;
   struct Embree;

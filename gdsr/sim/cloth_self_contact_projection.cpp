@@ -49,7 +49,9 @@ bool SelfCollision::project_pair(const Points3& x, const ProjectLimits& l, VT& c
                                l.min_mass_share * std::max({wp, wa, wb, wc}));
   if (!(wsum > 0)) return false;
   const Vec3 dir = (-C / wsum * c.side) * n;
-  out = {{c.v, ia, ib, ic}, {wp * dir, -(wa * bary.x() * dir), -(wb * bary.y() * dir), -(wc * bary.z() * dir)}};
+  out = {{c.v, ia, ib, ic},
+         {wp * dir, -(wa * bary.x() * dir), -(wb * bary.y() * dir), -(wc * bary.z() * dir)},
+         c.side * dist < 0};
   return true;
 }
 
@@ -84,18 +86,19 @@ bool SelfCollision::project_pair(const Points3& x, const ProjectLimits& l, EE& c
                                l.min_mass_share * std::max({w0, w1, w2, w3}));
   if (!(wsum > 0)) return false;
   const Vec3 step = (-C / wsum) * n;
-  out = {{i0, i1, j0, j1}, {w0 * (1 - s) * step, w1 * s * step, -(w2 * (1 - t) * step), -(w3 * t * step)}};
+  out = {{i0, i1, j0, j1}, {w0 * (1 - s) * step, w1 * s * step, -(w2 * (1 - t) * step), -(w3 * t * step)}, along <= 0};
   return true;
 }
 
 template <class Pair>
-int SelfCollision::project_in_order(Points3& x, const ProjectLimits& l, std::vector<Pair>& pairs) const {
+int SelfCollision::project_in_order(Points3& x, const ProjectLimits& l, std::vector<Pair>& pairs) {
   int pushed = 0;
   PairPush push;
   for (Pair& c : pairs)
     if (project_pair(x, l, c, push)) {
       push.apply(x);
       ++pushed;
+      crossed_pushed_ += push.crossed;
     }
   return pushed;
 }
@@ -113,6 +116,7 @@ template <class Pair> int SelfCollision::project_speculated(Points3& x, const Pr
       push.apply(x);
       mark_moved(push);
       ++pushed;
+      crossed_pushed_ += push.crossed;
     }
   }
   pairs.swap(evaluated);
@@ -132,6 +136,7 @@ int SelfCollision::project(Points3& x, const std::vector<double>& winv, double t
   const ProjectLimits l{&winv, thickness, max_crossed_push, min_mass_share};
   const long nvt = static_cast<long>(vt_.size()), nee = static_cast<long>(ee_.size());
   const size_t pairs = static_cast<size_t>(nvt + nee);
+  crossed_pushed_ = 0;
   if (pairs < kTwoThreadProjectPairs || omp_get_max_threads() < 2 ||
       (last_redone_share_ > kMostRedone && ++passes_in_order_ % kRetryEvery != 0))
     return project_in_order(x, l, vt_) + project_in_order(x, l, ee_);

@@ -496,7 +496,8 @@ void ClothSolver::refresh_contacts(const Points3& body_now, double h) {
 void ClothSolver::detect_self_contacts(double h) {
   // On the current (intersection-free) state, covering the motion of the next
   // self_detect_every substeps; sooner when a vertex left its slack (track_self_slack).
-  // The tangle test (edges crossing faces) runs at the first detection of each frame only:
+  // The tangle test (edges crossing faces) runs at the first detection of each frame, and
+  // again after a substep that ended pushing pairs back across (SimParams::self_tangle_retest):
   // it was a fifth of a detection's time, and an intersection that slipped through stays
   // guarded for at most one frame before it is freed to untangle.
   //
@@ -838,6 +839,9 @@ void ClothSolver::step(const Points3& body_from, const Points3& body_to, double 
       solve_body_contacts(body_prev, body_now);
       solve_self_contacts();
     }
+    // Self-contact ended the substep pushing pairs back across: maybe cloth pressed through itself
+    // with its sides taken from the crossed positions (SimParams::self_tangle_retest).
+    if (self_ && p_.self_tangle_retest && self_->num_crossed_pushed() > 0) tangle_test_due_ = true;
     update_velocities(h);
     track_self_slack();
   }

@@ -443,6 +443,19 @@ struct SimParams {
                                  // across the chest, CMU 61_03 frame 36), the crossings grew from 136 to 8,961 pairs
                                  // within one frame and tore the 10 mm t-shirt (770 edges longer than 2x their
                                  // pattern, up to 7.4x). What stays crossed is left to untangling (untangle_step)
+  bool self_tangle_retest = false;  // after a substep whose last self-contact pass pushed a pair back from the other
+                                    // side of its remembered one, the next detection runs the tangle test again, in
+                                    // full (no redetect); otherwise once a frame. In the armpit of the 30 mm t-shirt on
+                                    // salsa 61_03 (friction 0.30002), pressed between arm and torso, body contacts
+                                    // pushed the layers through each other, detections took the sides from the crossed
+                                    // positions, and self-contact held them crossed until the next frame's test: the
+                                    // tangle spread (LR frames free of self-intersections 70.6% -> 100% with it). Off:
+                                    // on the 24-clip 30 mm matrix (6 garments, CMU 01_01, salsa 60_02 and 61_03, walk
+                                    // 131_01, 4 s) it helped skirt_pleated on 131_01 (LR 80.1 -> 100%) and skirt_tiered
+                                    // on 61_03 (2nd run 86.0 -> 94.1%) but not skirt_tiered on 131_01 (76.5 -> 62.5%),
+                                    // and at 10 mm it cost the t-shirt on 61_03 (HR 100 -> 86.8%) and two nudged runs
+                                    // of skirt_pleated on 131_01 (86.8 / 84.6 -> 80.2 / 52.7%; the default run 86.0 ->
+                                    // 91.2%). Same CPU time within 5% (bench_cloth's retest rows)
   int self_passes = 1;  // self-contact Gauss-Seidel passes per iteration (stops early when none is violated). More
                         // passes clear a sphere drape at compression_pd_exponent 1, but not garments: on the 11
                         // matrix clips above at 1, 2 passes against 1 left fewer frames free of self-intersections
@@ -619,7 +632,7 @@ class ClothSolver {
   std::vector<char> redetected_;  // per vertex: its path was redetected since the last detection
   int since_detect_ = 1 << 30;  // substeps since the last detection
   int detect_interval_ = 1;     // substeps the last detection covers (self_detect_every or fewer for fast cloth)
-  bool tangle_test_due_ = true;  // the next detection also runs the tangle test (once per frame)
+  bool tangle_test_due_ = true;  // the next detection also runs the tangle test (once per frame and on cue)
   const GuideTracker* tracker_ = nullptr;
   const gdsr::Points3 *guide_from_ = nullptr, *guide_to_ = nullptr;
 };

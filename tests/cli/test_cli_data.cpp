@@ -310,6 +310,14 @@ TEST_CASE("cli data: --skip-built keeps a clip built by this solver revision and
   REQUIRE(refresh.status == 0);
   CHECK(refresh.out.find("built with another body contact refresh") != std::string::npos);
   CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"contact_every\": 3") != std::string::npos);
+  // And when cloth through itself is looked for (SimParams::self_tangle_retest).
+  const std::string as_before = cmd + " --start 0.1 --independent-hr --arm-clearance 0 --contact-every 3";
+  CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"self_tangle_retest\": false") != std::string::npos);
+  const Run once = gdsr_run(dir, as_before + " --tangle-retest");
+  REQUIRE(once.status == 0);
+  CHECK(once.out.find("built with another tangle test cue") != std::string::npos);
+  CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"self_tangle_retest\": true") != std::string::npos);
+  CHECK(gdsr_run(dir, as_before + " --tangle-retest").out.find("kept") != std::string::npos);
 }
 
 TEST_CASE("cli data: the t-shirt is simulated with its own body contact refresh, every 3rd substep") {
@@ -355,6 +363,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
                         " --compression-ratio 0.5 --compression-exponent 1.5 --settle-frames 3 --contact-every 2"
                         " --self-slack 0.002 --self-detect-every 3 --self-slack-per-pd 0.25 --self-passes 2"
                         " --no-limbs-pass-through --no-limbs-pass-until-clear --untangle-step 0.25 --no-self-redetect"
+                        " --tangle-retest"
                         " --track-rate 4 --max-push-step 0.01 --pinch-separation 0.08 --contact-travel 0"
                         " --pin-yield-rate 2.5 --dressed-radius 0.02");
   REQUIRE(mk.status == 0);
@@ -376,6 +385,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"limbs_pass_through\": false") != std::string::npos);
   CHECK(manifest.find("\"limbs_pass_until_clear\": false") != std::string::npos);
   CHECK(manifest.find("\"self_redetect\": false") != std::string::npos);
+  CHECK(manifest.find("\"self_tangle_retest\": true") != std::string::npos);
   CHECK(manifest.find("\"untangle_step\": 0.25") != std::string::npos);
   CHECK(manifest.find("\"hr_track_rate_1_s\": 4") != std::string::npos);
   CHECK(manifest.find("\"max_push_step_m\": 0.01") != std::string::npos);

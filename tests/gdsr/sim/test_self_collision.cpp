@@ -653,12 +653,14 @@ TEST_CASE("self-collision: a vertex found beyond its reach on the wrong side is 
   Points3 y = x;
   y(3, 1) = -0.001;
   CHECK(sc.project(y, winv, thickness) >= 1);
+  CHECK(sc.num_crossed_pushed() == 1);  // the solver's cue to look for intersections again
   CHECK(y(3, 1) == doctest::Approx(thickness).epsilon(1e-9));
   // 4 cm below, far beyond the pair's reach: an intersection that slipped through elsewhere.
   // Pushing it 4 cm back up tore the cloth into spikes; it is left to untangle.
   Points3 z = x;
   z(3, 1) = -0.04;
   CHECK(sc.project(z, winv, thickness) == 0);
+  CHECK(sc.num_crossed_pushed() == 0);
   CHECK(z(3, 1) == -0.04);
 }
 
@@ -691,6 +693,7 @@ TEST_CASE("self-collision: a pair found deep across, within its reach, is pushed
   Points3 close = x;  // 1 mm above: pushed to the thickness in one pass, capped or not
   close(3, 1) = 0.001;
   CHECK(sc.project(close, winv, thickness, thickness) == 1);
+  CHECK(sc.num_crossed_pushed() == 0);  // too close, not crossed
   CHECK(close(3, 1) == doctest::Approx(thickness).epsilon(1e-9));
 }
 
@@ -725,7 +728,8 @@ TEST_CASE("self-collision: the projection on two threads gives the one-thread pa
   // later pairs read. Every 17th vertex pinned (inverse mass 0), the crossed-push cap and the mass
   // floor on, as the solver calls it. Five passes on two threads (the first phase evaluates
   // every pair at the pass's starting positions, the second redoes the pairs a push has
-  // touched) against five on one: the same positions bit for bit, the same counts pushed.
+  // touched) against five on one: the same positions bit for bit, the same counts pushed (and
+  // pushed back across).
   const CrumpledSheets sheets(8);
   const auto& m = sheets.m;
   const int nv = static_cast<int>(m.V.rows());
@@ -734,23 +738,29 @@ TEST_CASE("self-collision: the projection on two threads gives the one-thread pa
   for (int v = 0; v < nv; v += 17) winv[v] = 0;
   Points3 pressed = sheets.x;
   for (int v = nv / 2; v < nv; ++v) pressed(v, 1) -= 0.002;  // the upper sheet: the second half
-  auto passes = [&](int threads, std::vector<int>& pushed) {
+  auto passes = [&](int threads, std::vector<int>& pushed, std::vector<int>& crossed) {
     const sim::OmpThreads scope(threads);
     sim::SelfCollision sc(m.F, nv);
     sc.detect(sheets.x, sheets.motion, slack, thickness);
     REQUIRE(static_cast<size_t>(sc.num_vertex_triangle() + sc.num_edge_edge()) >=
             sim::SelfCollision::kTwoThreadProjectPairs);
     Points3 y = pressed;
-    for (int k = 0; k < 5; ++k) pushed.push_back(sc.project(y, winv, thickness, thickness, 0.25));
+    for (int k = 0; k < 5; ++k) {
+      pushed.push_back(sc.project(y, winv, thickness, thickness, 0.25));
+      crossed.push_back(sc.num_crossed_pushed());
+    }
     return y;
   };
-  std::vector<int> pushed1, pushed2;
-  const Points3 one = passes(1, pushed1), two = passes(2, pushed2);
-  MESSAGE("pairs pushed per pass: " << pushed1[0] << " " << pushed1[1] << " " << pushed1[4]);
+  std::vector<int> pushed1, pushed2, crossed1, crossed2;
+  const Points3 one = passes(1, pushed1, crossed1), two = passes(2, pushed2, crossed2);
+  MESSAGE("pairs pushed per pass: " << pushed1[0] << " " << pushed1[1] << " " << pushed1[4] << ", back across "
+                                    << crossed1[0] << " " << crossed1[1] << " " << crossed1[4]);
   CHECK(pushed1[0] > 300);
   CHECK(pushed1[4] > 0);  // still pushing: each pass starts from the last one's moves
   CHECK((one - pressed).cwiseAbs().maxCoeff() > 1e-3);
   CHECK(pushed2 == pushed1);
+  CHECK(crossed1[0] > 0);  // pressed 2 mm, some pairs are found across
+  CHECK(crossed2 == crossed1);
   CHECK((two - one).cwiseAbs().maxCoeff() == 0.0);
 }
 
