@@ -183,8 +183,8 @@ BENCHMARK(BM_ClothSkirtShort)
     ->Args({30, 10, 2, 1, 0, 0, 0, 0, 1, 0})
     ->Args({30, 20, 4, 1, 0, 0, 0, 0, 1, 0})
     ->Args({10, 40, 1, 0, 0, 0, 0, 0, 1, 0})
-    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 1,
-            0})  // the default: slack 1.5 mm, detected at most every 8 substeps, 5 mm thick
+    // The default: slack 1.5 mm, detected at most every 8 substeps, 5 mm thick.
+    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 1, 0})
     ->Args({10, 10, 2, 1, 0, 0, 0, 0, 1, 0})
     // The 10 mm default before solver revision 8: the 30 mm mesh's 3 mm slack, detected at most
     // every 4 substeps. The same figures in 1.7x the time (SimParams::self_slack_per_pd).
