@@ -80,6 +80,7 @@ struct MakeArgs {
   bool limbs_pass_until_clear = true;
   bool self_redetect = true;
   bool self_tangle_retest = false;
+  bool self_refuse_crossing_push = false;
   bool independent_hr = false;  // settle HR from its own placement, not from the settled LR garment
   bool skip_built = false;      // keep --out when it already holds this clip, built and valid
   int rest_blend_frames = 15;
@@ -232,6 +233,7 @@ void run_make(const MakeArgs& a) {
   params.limbs_pass_until_clear = a.limbs_pass_until_clear;
   params.self_redetect = a.self_redetect;
   params.self_tangle_retest = a.self_tangle_retest;
+  params.self_refuse_crossing_push = a.self_refuse_crossing_push;
   sim::Garment lr_garment = sim::make_garment(a.garment, a.lr_pd, body.rest_mesh());
   sim::Garment hr_garment = sim::make_garment(a.garment, a.hr_pd, body.rest_mesh());
   gdsr::Dataset d;
@@ -300,6 +302,7 @@ void run_make(const MakeArgs& a) {
                   {"self_crossed_push", params.self_crossed_push},
                   {"self_redetect", params.self_redetect},
                   {"self_tangle_retest", params.self_tangle_retest},
+                  {"self_refuse_crossing_push", params.self_refuse_crossing_push},
                   {"untangle_step", params.untangle_step},
                   {"hr_track_rate_1_s", params.track_rate},
                   {"compression_ratio", params.compression_ratio},
@@ -376,6 +379,10 @@ bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why
     }
     if (sp.value("self_tangle_retest", false) != a.self_tangle_retest) {
       why = "built with another tangle test cue";
+      return false;
+    }
+    if (sp.value("self_refuse_crossing_push", false) != a.self_refuse_crossing_push) {
+      why = "built with another rule for pushes back across";
       return false;
     }
     if (sp.value("hr_start", "") != hr_start_name(a)) {
@@ -837,6 +844,10 @@ void add_data_command(CLI::App& app) {
   make->add_flag("--tangle-retest", mk->self_tangle_retest,
                  "look for cloth through itself also after a substep whose self-contact pass pushed pairs back "
                  "across, not only once a frame (sim::SimParams::self_tangle_retest has the trade)");
+  make->add_flag("--refuse-crossing-push", mk->self_refuse_crossing_push,
+                 "refuse a self-contact push back to a pair's remembered side that would make the cloth's faces "
+                 "intersect; the pair takes the side it is on (sim::SimParams::self_refuse_crossing_push has the "
+                 "trade)");
   make->add_flag("!--no-limbs-pass-through", mk->limbs_pass_through,
                  "keep body contacts around cloth that a hand went through, so the hand carries it (solver "
                  "revision 10)");

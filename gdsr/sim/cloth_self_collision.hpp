@@ -20,6 +20,8 @@
 // points) it was when found, and the constraint pushes it back to that side. The side is
 // refreshed while crossing is legal (the vertex projects outside the triangle; the closest
 // points of the edges lie at an end) and, for edges, while they are apart on that side.
+// Optionally (set_refuse_crossing_pushes) a push back to the remembered side that would make the
+// pair's faces intersect where they do not is refused, and the pair takes the side it is on.
 //
 // Untangling: edges that already cross a triangle (an intersection that slipped through)
 // mark their and the triangle's vertices "tangled"; pairs touching a tangled vertex, or found
@@ -106,6 +108,12 @@ class SelfCollision {
 
   // Pairs the last project() pushed back from the other side of their remembered one.
   int num_crossed_pushed() const { return crossed_pushed_; }
+  // refuse: a push back across (as above) that would make the pair's faces intersect where they
+  // do not is refused, and the pair takes the side it is on: its remembered side was taken from
+  // positions that body contacts had pressed through (SimParams::self_refuse_crossing_push has the
+  // trade; off by default). num_sides_corrected: the pushes the last project() refused.
+  void set_refuse_crossing_pushes(bool refuse) { refuse_crossing_pushes_ = refuse; }
+  int num_sides_corrected() const { return sides_corrected_; }
   int num_vertex_triangle() const { return static_cast<int>(vt_.size()); }
   int num_edge_edge() const { return static_cast<int>(ee_.size()); }
   // Vertices of edges and triangles found crossing each other at the last tangle test.
@@ -178,6 +186,14 @@ class SelfCollision {
   template <class Pair> int project_speculated(gdsr::Points3& x, const ProjectLimits& l, std::vector<Pair>& pairs,
                                                std::vector<Pair>& evaluated, const std::vector<char>& pushes,
                                                size_t& redone);
+  // With set_refuse_crossing_pushes: a push back across that makes the pair's faces (VT: the
+  // vertex's faces and the triangle; EE: the two edges' faces) intersect where they did not is
+  // refused and the pair takes the current side. True if refused.
+  bool refuse_crossing_push(gdsr::Points3& x, VT& c, const PairPush& push);
+  bool refuse_crossing_push(gdsr::Points3& x, EE& c, const PairPush& push);
+  bool faces_cross(const gdsr::Points3& x, const int* fa, int na, const int* fb, int nb) const;
+  bool faces_cross(const gdsr::Points3& x, const VT& c) const;
+  bool faces_cross(const gdsr::Points3& x, const EE& c) const;
   bool touches(const VT& c) const { return moved_v_[c.v] | moved_f_[c.f]; }
   bool touches(const EE& c) const { return moved_e_[c.a] | moved_e_[c.b]; }
   void mark_moved(const PairPush& push);
@@ -197,6 +213,8 @@ class SelfCollision {
   int passes_in_order_ = 0;                // since then
   int intersecting_ = 0;
   int crossed_pushed_ = 0;
+  int sides_corrected_ = 0;
+  bool refuse_crossing_pushes_ = false;
   long long detections_ = 0;
   long long redetections_ = 0;
   struct Embree;

@@ -96,6 +96,7 @@ int SelfCollision::project_in_order(Points3& x, const ProjectLimits& l, std::vec
   PairPush push;
   for (Pair& c : pairs)
     if (project_pair(x, l, c, push)) {
+      if (push.crossed && refuse_crossing_pushes_ && refuse_crossing_push(x, c, push)) continue;
       push.apply(x);
       ++pushed;
       crossed_pushed_ += push.crossed;
@@ -113,6 +114,7 @@ template <class Pair> int SelfCollision::project_speculated(Points3& x, const Pr
     ++redone;
     Pair& c = evaluated[i] = pairs[i];
     if (project_pair(x, l, c, push)) {
+      if (push.crossed && refuse_crossing_pushes_ && refuse_crossing_push(x, c, push)) continue;
       push.apply(x);
       mark_moved(push);
       ++pushed;
@@ -121,6 +123,68 @@ template <class Pair> int SelfCollision::project_speculated(Points3& x, const Pr
   }
   pairs.swap(evaluated);
   return pushed;
+}
+
+bool SelfCollision::faces_cross(const Points3& x, const int* fa, int na, const int* fb, int nb) const {
+  auto shares = [&](int f, int g) {
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (F_(f, i) == F_(g, j)) return true;
+    return false;
+  };
+  auto edge_crosses = [&](int f, int g) {  // an edge of face f through face g
+    const Vec3 a = x.row(F_(g, 0)), b = x.row(F_(g, 1)), c = x.row(F_(g, 2));
+    for (int i = 0; i < 3; ++i)
+      if (segment_crosses_triangle(x.row(F_(f, i)), x.row(F_(f, (i + 1) % 3)), a, b, c)) return true;
+    return false;
+  };
+  for (int i = 0; i < na; ++i)
+    for (int j = 0; j < nb; ++j)
+      if (fa[i] >= 0 && fb[j] >= 0 && !shares(fa[i], fb[j]) &&
+          (edge_crosses(fa[i], fb[j]) || edge_crosses(fb[j], fa[i])))
+        return true;
+  return false;
+}
+
+bool SelfCollision::faces_cross(const Points3& x, const VT& c) const {
+  return faces_cross(x, vertex_faces_.items.data() + vertex_faces_.offsets[c.v], vertex_faces_.count(c.v), &c.f, 1);
+}
+
+bool SelfCollision::faces_cross(const Points3& x, const EE& c) const {
+  return faces_cross(x, edge_faces_[c.a].data(), 2, edge_faces_[c.b].data(), 2);
+}
+
+namespace {
+// True if `push` would make the pair's faces intersect where they do not now; x is left as it was.
+template <class Pair, class Cross>
+bool push_makes_crossing(Points3& x, const Pair& c, const Cross& cross, const gdsr::Vec3* d, const int* v) {
+  if (cross(x, c)) return false;  // crossing already: pushing back undoes it
+  Vec3 kept[4];
+  for (int k = 0; k < 4; ++k) kept[k] = x.row(v[k]), x.row(v[k]) += d[k].transpose();
+  const bool made = cross(x, c);
+  for (int k = 0; k < 4; ++k) x.row(v[k]) = kept[k].transpose();
+  return made;
+}
+}  // namespace
+
+bool SelfCollision::refuse_crossing_push(Points3& x, VT& c, const PairPush& push) {
+  auto cross = [&](const Points3& y, const VT& p) { return faces_cross(y, p); };
+  if (!push_makes_crossing(x, c, cross, push.d, push.v)) return false;
+  c.side = static_cast<signed char>(-c.side);
+  ++sides_corrected_;
+  return true;
+}
+
+bool SelfCollision::refuse_crossing_push(Points3& x, EE& c, const PairPush& push) {
+  auto cross = [&](const Points3& y, const EE& p) { return faces_cross(y, p); };
+  if (!push_makes_crossing(x, c, cross, push.d, push.v)) return false;
+  const int i0 = edges_[c.a][0], i1 = edges_[c.a][1], j0 = edges_[c.b][0], j1 = edges_[c.b][1];
+  double s = 0, t = 0;
+  closest_segments(x.row(i0), x.row(i1), x.row(j0), x.row(j1), s, t);
+  const Vec3 d = (x.row(i0) + s * (x.row(i1) - x.row(i0))) - (x.row(j0) + t * (x.row(j1) - x.row(j0)));
+  if (d.norm() > 0) c.set_dir(d.normalized());
+  ++sides_corrected_;
+  return true;
 }
 
 void SelfCollision::mark_moved(const PairPush& push) {
@@ -137,6 +201,7 @@ int SelfCollision::project(Points3& x, const std::vector<double>& winv, double t
   const long nvt = static_cast<long>(vt_.size()), nee = static_cast<long>(ee_.size());
   const size_t pairs = static_cast<size_t>(nvt + nee);
   crossed_pushed_ = 0;
+  sides_corrected_ = 0;
   if (pairs < kTwoThreadProjectPairs || omp_get_max_threads() < 2 ||
       (last_redone_share_ > kMostRedone && ++passes_in_order_ % kRetryEvery != 0))
     return project_in_order(x, l, vt_) + project_in_order(x, l, ee_);

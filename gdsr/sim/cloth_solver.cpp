@@ -269,6 +269,7 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     const double longer = std::round(p.self_detect_every * (p.self_slack / p_.self_slack));
     p_.self_detect_every = static_cast<int>(std::min(longer, 1000.0));
     self_ = std::make_unique<SelfCollision>(F_, nv);
+    self_->set_refuse_crossing_pushes(p_.self_refuse_crossing_push);
     motion_ = Points3::Zero(nv, 3);
   }
 }

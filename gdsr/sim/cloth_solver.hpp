@@ -435,7 +435,12 @@ struct SimParams {
                                     // 1.5 mm the 30 mm skirt_tiered folded through itself (35% clean frames)
   double untangle_step = 0.1;       // per substep, the most an edge crossing a face (an intersection that slipped
                                     // through) is moved to shrink the intersection contour, in self_thickness
-                                    // (SelfCollision::untangle; 0: off)
+                                    // (SelfCollision::untangle; 0: off). 0.3 tried on 2026-12-06, not kept: on
+                                    // the 30 mm matrix (LR / 2nd run) skirt_pleated 131_01 80.1 / 100 -> 90.4 /
+                                    // 96.3%, skirt_tiered 61_03 100 / 86.0 -> 100 / 90.4%, dress_layered 60_02
+                                    // 100 / 97.8 -> 100 / 98.5%, 21 clips unchanged;
+                                    // at 10 mm skirt_pleated 131_01, friction 0.3 / 0.30001 / 0.30002, HR
+                                    // 86.0 / 91.2 / 89.7 -> 88.2 / 88.2 / 87.5%: its knots do not wait on the step
   double self_crossed_push = 1;     // per self-contact pass, the most a pair found crossed (on the other side from the
                                  // one it was detected on, within its reach) is pushed back, in self_thickness (>= 1;
                                  // infinity: all the way). Pushed all the way back, by up to 36 mm at 10 mm, while
@@ -455,7 +460,31 @@ struct SimParams {
                                     // on 61_03 (2nd run 86.0 -> 94.1%) but not skirt_tiered on 131_01 (76.5 -> 62.5%),
                                     // and at 10 mm it cost the t-shirt on 61_03 (HR 100 -> 86.8%) and two nudged runs
                                     // of skirt_pleated on 131_01 (86.8 / 84.6 -> 80.2 / 52.7%; the default run 86.0 ->
-                                    // 91.2%). Same CPU time within 5% (bench_cloth's retest rows)
+                                    // 91.2%). Same CPU time within 5% (bench_cloth's retest rows).
+                                    // Tried on 2026-12-06, not kept: a pair found again at a detection kept the side
+                                    // it remembered instead of taking it from the positions (which may hold a
+                                    // crossing the last pass had not undone yet). 30 mm matrix, LR / 2nd run: it
+                                    // freed skirt_pleated on 131_01 (80.1 / 100 -> 100 / 100%) and pants on 131_01
+                                    // (89.7 -> 100%) but knotted the t-shirt's elbow crook (60_02: 100 -> 19.9%,
+                                    // 61_03: 100 / 100 -> 60.3 / 92.6%) and left 1-2 crossed frames on 4 clean
+                                    // clips; at 10 mm skirt_pleated on 131_01, friction 0.3 / 0.30001 / 0.30002:
+                                    // 86.0 / 91.2 / 89.7 -> 89.7 / 87.5 / 35.3% of HR frames clean
+  bool self_refuse_crossing_push = false;  // a self-contact push back to a pair's remembered side that would make the
+                                           // pair's faces intersect where they do not is refused, and the pair takes
+                                           // the side it is on (SelfCollision::set_refuse_crossing_pushes): in the
+                                           // armpit above, self-contact pushed the layers back through each other
+                                           // after the body had pushed them apart ("body: 8 -> 0 crossings, self: 0 ->
+                                           // 8"). It frees that case (70.6 / 94.1 -> 100 / 100%, with no tangle
+                                           // retest). Off: at 10 mm the t-shirt on 61_03 went 100 -> 69.9% of HR
+                                           // frames clean (the forearm pressed across the trunk pushes the sleeve
+                                           // through the shirt farther than a 10 mm face, so the faces around the pair
+                                           // no longer intersect and the push back is refused; refusing only pairs
+                                           // whose side was taken from intersecting faces: 69.1%).
+                                           // 30 mm matrix (LR / 2nd run, as above): dress_layered 60_02 100 / 97.8 ->
+                                           // 100 / 100%, skirt_tiered 61_03 100 / 86.0 -> 100 / 100%, skirt_tiered
+                                           // 131_01 76.5 / 75.7 -> 61.8 / 75.0%, 20 clips unchanged; 10 mm
+                                           // skirt_pleated 131_01 at friction 0.3 / 0.30001 / 0.30002: HR 86.0 / 91.2 /
+                                           // 89.7 -> 89.7 / 100 / 89.0%. CPU within 4%
   int self_passes = 1;  // self-contact Gauss-Seidel passes per iteration (stops early when none is violated). More
                         // passes clear a sphere drape at compression_pd_exponent 1, but not garments: on the 11
                         // matrix clips above at 1, 2 passes against 1 left fewer frames free of self-intersections

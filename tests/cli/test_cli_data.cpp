@@ -318,6 +318,12 @@ TEST_CASE("cli data: --skip-built keeps a clip built by this solver revision and
   CHECK(once.out.find("built with another tangle test cue") != std::string::npos);
   CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"self_tangle_retest\": true") != std::string::npos);
   CHECK(gdsr_run(dir, as_before + " --tangle-retest").out.find("kept") != std::string::npos);
+  // And how self-contact pushes pairs back across (SimParams::self_refuse_crossing_push).
+  CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"self_refuse_crossing_push\": false") != std::string::npos);
+  const Run refusing = gdsr_run(dir, as_before + " --tangle-retest --refuse-crossing-push");
+  REQUIRE(refusing.status == 0);
+  CHECK(refusing.out.find("built with another rule for pushes back across") != std::string::npos);
+  CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"self_refuse_crossing_push\": true") != std::string::npos);
 }
 
 TEST_CASE("cli data: the t-shirt is simulated with its own body contact refresh, every 3rd substep") {
@@ -363,7 +369,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
                         " --compression-ratio 0.5 --compression-exponent 1.5 --settle-frames 3 --contact-every 2"
                         " --self-slack 0.002 --self-detect-every 3 --self-slack-per-pd 0.25 --self-passes 2"
                         " --no-limbs-pass-through --no-limbs-pass-until-clear --untangle-step 0.25 --no-self-redetect"
-                        " --tangle-retest"
+                        " --tangle-retest --refuse-crossing-push"
                         " --track-rate 4 --max-push-step 0.01 --pinch-separation 0.08 --contact-travel 0"
                         " --pin-yield-rate 2.5 --dressed-radius 0.02");
   REQUIRE(mk.status == 0);
@@ -386,6 +392,7 @@ TEST_CASE("cli data: solver knobs reach the solver and the manifest / values out
   CHECK(manifest.find("\"limbs_pass_until_clear\": false") != std::string::npos);
   CHECK(manifest.find("\"self_redetect\": false") != std::string::npos);
   CHECK(manifest.find("\"self_tangle_retest\": true") != std::string::npos);
+  CHECK(manifest.find("\"self_refuse_crossing_push\": true") != std::string::npos);
   CHECK(manifest.find("\"untangle_step\": 0.25") != std::string::npos);
   CHECK(manifest.find("\"hr_track_rate_1_s\": 4") != std::string::npos);
   CHECK(manifest.find("\"max_push_step_m\": 0.01") != std::string::npos);

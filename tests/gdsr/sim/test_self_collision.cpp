@@ -90,6 +90,16 @@ sim::Garment flap_through_sheet() {
   return g;
 }
 
+// Self-contact pairs of faces F detected at `pressed`, cloth pressed through itself, without a
+// tangle test (as the solver's detections within a frame); pushes into intersections refused or not.
+std::unique_ptr<sim::SelfCollision> detected_pressed(const gdsr::Faces& F, const Points3& pressed, double slack,
+                                                     double thickness, bool refuse) {
+  auto sc = std::make_unique<sim::SelfCollision>(F, static_cast<int>(pressed.rows()));
+  sc->set_refuse_crossing_pushes(refuse);
+  sc->detect(pressed, Points3::Zero(pressed.rows(), 3), slack, thickness, false);
+  return sc;
+}
+
 }  // namespace
 
 TEST_CASE("self-collision: the CGAL yardstick counts crossing triangles and ignores neighbours") {
@@ -664,6 +674,82 @@ TEST_CASE("self-collision: a vertex found beyond its reach on the wrong side is 
   CHECK(z(3, 1) == -0.04);
 }
 
+TEST_CASE("self-collision: a push back across that would make the faces intersect is refused, the side corrected") {
+  // A small fan of four triangles around vertex 3, fixed at its rim 2 mm above a fixed
+  // triangle, its centre free. Detected while the centre was pressed 1 mm through the triangle
+  // (no tangle test, as the solver's detections within a frame), the pair remembers the wrong
+  // side; then the centre is back above (a body contact undid the press) and nothing
+  // intersects. Pushed back to its remembered side, the centre would pull the fan's edges
+  // through the triangle: with set_refuse_crossing_pushes the push is refused, the side taken
+  // from the geometry, and the next pass keeps the centre a thickness above; without (the
+  // solver's default), it goes 3 mm below.
+  const gdsr::Faces F = (gdsr::Faces(5, 3) << 0, 1, 2, 3, 4, 6, 3, 6, 5, 3, 5, 7, 3, 7, 4).finished();
+  Points3 x(8, 3);
+  x << 0, 0, 0, 0.1, 0, 0, 0, 0, 0.1,                                              // the triangle
+      0.03, 0.001, 0.03,                                                           // the fan's centre
+      0.01, 0.002, 0.03, 0.05, 0.002, 0.03, 0.03, 0.002, 0.01, 0.03, 0.002, 0.05;  // its rim
+  const std::vector<double> winv = {0, 0, 0, 1, 0, 0, 0, 0};
+  const double thickness = 0.003, slack = 0.001;
+  Points3 pressed = x;
+  pressed(3, 1) = -0.001;
+  REQUIRE(gdsr::self_intersections(pressed, F).pairs > 0);
+  REQUIRE(gdsr::self_intersections(x, F).pairs == 0);
+  const auto pushing = detected_pressed(F, pressed, slack, thickness, false);
+  Points3 w = x;
+  pushing->project(w, winv, thickness);
+  CHECK(pushing->num_crossed_pushed() == 1);
+  CHECK(w(3, 1) == doctest::Approx(-thickness).epsilon(1e-9));
+  CHECK(gdsr::self_intersections(w, F).pairs > 0);
+  const auto sc = detected_pressed(F, pressed, slack, thickness, true);
+  REQUIRE(sc->num_tangled_vertices() == 0);
+  Points3 y = x;
+  sc->project(y, winv, thickness);
+  CHECK(sc->num_sides_corrected() == 1);
+  CHECK(sc->num_crossed_pushed() == 0);
+  CHECK(y(3, 1) == 0.001);  // not moved by the refused push
+  sc->project(y, winv, thickness);
+  CHECK(sc->num_sides_corrected() == 0);
+  CHECK(y(3, 1) == doctest::Approx(thickness).epsilon(1e-9));
+  CHECK(gdsr::self_intersections(y, F).pairs == 0);
+  // A pair that is still crossing is pushed back as before (the push undoes the crossing).
+  Points3 z = pressed;
+  sim::SelfCollision again(F, 8);
+  again.set_refuse_crossing_pushes(true);
+  again.detect(x, Points3::Zero(8, 3), slack, thickness);
+  again.project(z, winv, thickness);
+  CHECK(again.num_sides_corrected() == 0);
+  CHECK(again.num_crossed_pushed() == 1);
+  CHECK(z(3, 1) == doctest::Approx(thickness).epsilon(1e-9));
+}
+
+TEST_CASE("self-collision: an edge pair pushed back across into an intersection is refused, the side corrected") {
+  // Two upright triangles whose free edges cross at right angles: the upper one's bottom edge
+  // (along x, free) and the lower one's top edge (along z, fixed). Detected while the upper
+  // edge was pressed 1 mm below the lower one (the triangles intersect), then back 1 mm above
+  // (they do not): with set_refuse_crossing_pushes the push back to the remembered side below
+  // is refused, and the edge is kept a thickness above.
+  const gdsr::Faces F = (gdsr::Faces(2, 3) << 0, 1, 2, 3, 4, 5).finished();
+  Points3 x(6, 3);
+  x << -0.05, 0.001, 0, 0.05, 0.001, 0, 0, 0.1, 0,  // upper, in the plane z = 0
+      0, 0, -0.05, 0, 0, 0.05, 0, -0.1, 0;          // lower, in the plane x = 0
+  const std::vector<double> winv = {1, 1, 0, 0, 0, 0};
+  const double thickness = 0.003, slack = 0.001;
+  Points3 pressed = x;
+  pressed(0, 1) = pressed(1, 1) = -0.001;
+  REQUIRE(gdsr::self_intersections(pressed, F).pairs > 0);
+  REQUIRE(gdsr::self_intersections(x, F).pairs == 0);
+  const auto sc = detected_pressed(F, pressed, slack, thickness, true);
+  REQUIRE(sc->num_edge_edge() == 1);
+  Points3 y = x;
+  sc->project(y, winv, thickness);
+  CHECK(sc->num_sides_corrected() == 1);
+  CHECK(y(0, 1) == 0.001);
+  sc->project(y, winv, thickness);
+  CHECK(y(0, 1) == doctest::Approx(thickness).epsilon(1e-9));
+  CHECK(y(1, 1) == y(0, 1));
+  CHECK(gdsr::self_intersections(y, F).pairs == 0);
+}
+
 TEST_CASE("self-collision: a pair found deep across, within its reach, is pushed back by at most the cap per pass") {
   // A triangle and a lone vertex as above (a larger triangle: no corner within the vertex's
   // reach), detected while the vertex moves 5 cm down (reach 3 + 50 + 2 mm): found 3 cm
@@ -738,9 +824,11 @@ TEST_CASE("self-collision: the projection on two threads gives the one-thread pa
   for (int v = 0; v < nv; v += 17) winv[v] = 0;
   Points3 pressed = sheets.x;
   for (int v = nv / 2; v < nv; ++v) pressed(v, 1) -= 0.002;  // the upper sheet: the second half
-  auto passes = [&](int threads, std::vector<int>& pushed, std::vector<int>& crossed) {
+  bool refuse = false;
+  auto passes = [&](int threads, std::vector<int>& pushed, std::vector<int>& crossed, std::vector<int>& corrected) {
     const sim::OmpThreads scope(threads);
     sim::SelfCollision sc(m.F, nv);
+    sc.set_refuse_crossing_pushes(refuse);
     sc.detect(sheets.x, sheets.motion, slack, thickness);
     REQUIRE(static_cast<size_t>(sc.num_vertex_triangle() + sc.num_edge_edge()) >=
             sim::SelfCollision::kTwoThreadProjectPairs);
@@ -748,11 +836,12 @@ TEST_CASE("self-collision: the projection on two threads gives the one-thread pa
     for (int k = 0; k < 5; ++k) {
       pushed.push_back(sc.project(y, winv, thickness, thickness, 0.25));
       crossed.push_back(sc.num_crossed_pushed());
+      corrected.push_back(sc.num_sides_corrected());
     }
     return y;
   };
-  std::vector<int> pushed1, pushed2, crossed1, crossed2;
-  const Points3 one = passes(1, pushed1, crossed1), two = passes(2, pushed2, crossed2);
+  std::vector<int> pushed1, pushed2, crossed1, crossed2, corrected1, corrected2;
+  const Points3 one = passes(1, pushed1, crossed1, corrected1), two = passes(2, pushed2, crossed2, corrected2);
   MESSAGE("pairs pushed per pass: " << pushed1[0] << " " << pushed1[1] << " " << pushed1[4] << ", back across "
                                     << crossed1[0] << " " << crossed1[1] << " " << crossed1[4]);
   CHECK(pushed1[0] > 300);
@@ -761,7 +850,20 @@ TEST_CASE("self-collision: the projection on two threads gives the one-thread pa
   CHECK(pushed2 == pushed1);
   CHECK(crossed1[0] > 0);  // pressed 2 mm, some pairs are found across
   CHECK(crossed2 == crossed1);
+  CHECK(corrected2 == corrected1);
   CHECK((two - one).cwiseAbs().maxCoeff() == 0.0);
+  // The same with pushes that would make faces intersect refused (SimParams::self_refuse_crossing_push).
+  refuse = true;
+  std::vector<int> pushed3, pushed4, crossed3, crossed4, corrected3, corrected4;
+  const Points3 three = passes(1, pushed3, crossed3, corrected3), four = passes(2, pushed4, crossed4, corrected4);
+  int refused = 0;
+  for (int n : corrected3) refused += n;
+  MESSAGE("pushes refused over the five passes: " << refused);
+  CHECK(refused > 0);
+  CHECK(pushed4 == pushed3);
+  CHECK(crossed4 == crossed3);
+  CHECK(corrected4 == corrected3);
+  CHECK((four - three).cwiseAbs().maxCoeff() == 0.0);
 }
 
 TEST_CASE("self-collision: resting layers are kept the larger of the thickness and a sixth of the particle distance apart") {

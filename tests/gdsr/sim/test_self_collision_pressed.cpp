@@ -20,7 +20,7 @@ namespace {
 struct Crossed {
   int frames = 0, checked = 0;
 };
-Crossed tshirt_armpit_crossed_frames(bool tangle_retest) {
+Crossed tshirt_armpit_crossed_frames(bool refuse_crossing_push, bool tangle_retest) {
   const std::string bvh = std::string(GDSR_SHARED_DIR) + "/motions/cmu-salsa/61_03.bvh";
   REQUIRE_MESSAGE(std::ifstream(bvh).good(), bvh << " is missing (../shared beside the repository)");
   gdsr::BodyOptions opt;
@@ -33,6 +33,7 @@ Crossed tshirt_armpit_crossed_frames(bool tangle_retest) {
   sim::SimParams p;
   p.contact_every = sim::body_contact_every("tshirt", p.contact_every);
   p.friction = 0.30002;  // the draw of seven nudged frictions whose armpit crossed (0.3 to 0.30006)
+  p.self_refuse_crossing_push = refuse_crossing_push;
   p.self_tangle_retest = tangle_retest;
   const std::vector<gdsr::Points3> frames = sim::simulate(g, body, p);
   REQUIRE(frames.size() == 136);
@@ -46,19 +47,24 @@ Crossed tshirt_armpit_crossed_frames(bool tangle_retest) {
 
 }  // namespace
 
-TEST_CASE("self-collision: layers a limb presses through each other mid-frame are found then, not locked in") {
+TEST_CASE("self-collision: layers a limb presses through each other mid-frame are freed by either opt-in rule") {
   // From frame ~125 the dancer's arm presses the shirt's side onto its sleeve in the left armpit:
   // body contacts (opposite normals, arm and trunk) push one layer through the other within a
-  // substep. The tangle test ran once a frame; the detections in between took the pairs' sides
-  // from the crossed positions, self-contact then held the layers crossed (undoing the body's
-  // pushes back), and by the next frame's test the tangle had spread to over a thousand pairs.
-  // With SimParams::self_tangle_retest a substep whose self-contact pass pushed pairs back across
-  // has the next detection run the tangle test, so the crossing is freed and untangled. (Off by
-  // default: at 10 mm it cost other clips more than it gained; its comment has the figures.)
-  const Crossed with = tshirt_armpit_crossed_frames(true);
-  MESSAGE("frames with self-intersections: " << with.frames << " of " << with.checked);
-  CHECK(with.frames == 0);
-  const Crossed without = tshirt_armpit_crossed_frames(false);  // the test can fail: locked in
-  MESSAGE("... the tangle test once a frame (the default): " << without.frames << " of " << without.checked);
-  CHECK(without.frames >= 5);
+  // substep. The tangle test runs once a frame; the detections in between took the pairs' sides
+  // from the crossed positions, and when the body pushed the layers back apart, self-contact
+  // pushed them through again, towards those sides. By the next frame's test the tangle had
+  // spread to over a thousand pairs. Two rules free it, both off by default (at 10 mm each cost
+  // other clips more than it gained; their comments in SimParams have the figures):
+  // self_tangle_retest (a substep whose self-contact pass pushed pairs back across has the next
+  // detection run the tangle test) and self_refuse_crossing_push (a push back across that would
+  // make the pair's faces intersect where they do not is refused, the pair takes its side).
+  const Crossed retest = tshirt_armpit_crossed_frames(false, true);
+  MESSAGE("frames with self-intersections, tangle retest: " << retest.frames << " of " << retest.checked);
+  CHECK(retest.frames == 0);
+  const Crossed refuse = tshirt_armpit_crossed_frames(true, false);
+  MESSAGE("... pushes into intersections refused: " << refuse.frames << " of " << refuse.checked);
+  CHECK(refuse.frames == 0);
+  const Crossed neither = tshirt_armpit_crossed_frames(false, false);  // the test can fail: locked in
+  MESSAGE("... neither (the default): " << neither.frames << " of " << neither.checked);
+  CHECK(neither.frames >= 5);
 }
