@@ -113,6 +113,11 @@ class SelfCollision {
   // positions that body contacts had pressed through (SimParams::self_refuse_crossing_push has the
   // trade; off by default). num_sides_corrected: the pushes the last project() refused.
   void set_refuse_crossing_pushes(bool refuse) { refuse_crossing_pushes_ = refuse; }
+  // body_moved (per vertex, 1: a body contact moved it in this iteration; kept by the caller,
+  // null: every vertex counts as moved): only pushes of pairs with such a vertex are refused.
+  // Where a limb holds a layer through another (at 10 mm farther than a face's width, so the
+  // faces around the pair no longer intersect), the push back is then still made.
+  void set_body_moved(const std::vector<char>* body_moved) { body_moved_ = body_moved; }
   int num_sides_corrected() const { return sides_corrected_; }
   int num_vertex_triangle() const { return static_cast<int>(vt_.size()); }
   int num_edge_edge() const { return static_cast<int>(ee_.size()); }
@@ -197,6 +202,7 @@ class SelfCollision {
   bool touches(const VT& c) const { return moved_v_[c.v] | moved_f_[c.f]; }
   bool touches(const EE& c) const { return moved_e_[c.a] | moved_e_[c.b]; }
   void mark_moved(const PairPush& push);
+  bool body_touched(const PairPush& push) const;
   gdsr::Faces F_;
   std::vector<std::array<int, 2>> edges_;  // unique edges (i < j)
   std::vector<std::array<int, 2>> edge_faces_;  // the (one or two) faces of each edge, -1: none
@@ -215,6 +221,7 @@ class SelfCollision {
   int crossed_pushed_ = 0;
   int sides_corrected_ = 0;
   bool refuse_crossing_pushes_ = false;
+  const std::vector<char>* body_moved_ = nullptr;  // see set_body_moved
   long long detections_ = 0;
   long long redetections_ = 0;
   struct Embree;

@@ -96,7 +96,7 @@ int SelfCollision::project_in_order(Points3& x, const ProjectLimits& l, std::vec
   PairPush push;
   for (Pair& c : pairs)
     if (project_pair(x, l, c, push)) {
-      if (push.crossed && refuse_crossing_pushes_ && refuse_crossing_push(x, c, push)) continue;
+      if (push.crossed && refuse_crossing_pushes_ && body_touched(push) && refuse_crossing_push(x, c, push)) continue;
       push.apply(x);
       ++pushed;
       crossed_pushed_ += push.crossed;
@@ -114,7 +114,7 @@ template <class Pair> int SelfCollision::project_speculated(Points3& x, const Pr
     ++redone;
     Pair& c = evaluated[i] = pairs[i];
     if (project_pair(x, l, c, push)) {
-      if (push.crossed && refuse_crossing_pushes_ && refuse_crossing_push(x, c, push)) continue;
+      if (push.crossed && refuse_crossing_pushes_ && body_touched(push) && refuse_crossing_push(x, c, push)) continue;
       push.apply(x);
       mark_moved(push);
       ++pushed;
@@ -185,6 +185,13 @@ bool SelfCollision::refuse_crossing_push(Points3& x, EE& c, const PairPush& push
   if (d.norm() > 0) c.set_dir(d.normalized());
   ++sides_corrected_;
   return true;
+}
+
+bool SelfCollision::body_touched(const PairPush& push) const {
+  if (!body_moved_) return true;
+  for (int v : push.v)
+    if ((*body_moved_)[v]) return true;
+  return false;
 }
 
 void SelfCollision::mark_moved(const PairPush& push) {

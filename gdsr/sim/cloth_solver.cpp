@@ -270,6 +270,8 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     p_.self_detect_every = static_cast<int>(std::min(longer, 1000.0));
     self_ = std::make_unique<SelfCollision>(F_, nv);
     self_->set_refuse_crossing_pushes(p_.self_refuse_crossing_push);
+    body_moved_.assign(nv, 0);
+    self_->set_body_moved(&body_moved_);
     motion_ = Points3::Zero(nv, 3);
   }
 }
@@ -677,6 +679,7 @@ void ClothSolver::solve_body_contacts(const Points3& body_prev, const Points3& b
   // before.
   int pushed_v = -1;
   double pushed = 0;
+  std::fill(body_moved_.begin(), body_moved_.end(), 0);
   auto depth = [&](const Contact& c) {
     return (x_.row(c.v).transpose() - bary_point(body_now, bodyF_, c.face, c.bary))
                .dot(face_normal(body_now, bodyF_, c.face)) -
@@ -732,6 +735,7 @@ void ClothSolver::solve_body_contacts(const Points3& body_prev, const Points3& b
     const double lim = p_.friction * (-C);
     if (rl > 0 && !c.passing) x -= (rl <= lim ? 1.0 : lim / rl) * rel;
     x_.row(c.v) = x.transpose();
+    if (!body_moved_.empty()) body_moved_[c.v] = 1;
   }
 }
 

@@ -470,23 +470,26 @@ struct SimParams {
                                     // 61_03: 100 / 100 -> 60.3 / 92.6%) and left 1-2 crossed frames on 4 clean
                                     // clips; at 10 mm skirt_pleated on 131_01, friction 0.3 / 0.30001 / 0.30002:
                                     // 86.0 / 91.2 / 89.7 -> 89.7 / 87.5 / 35.3% of HR frames clean
-  bool self_refuse_crossing_push = false;  // a self-contact push back to a pair's remembered side that would make the
-                                           // pair's faces intersect where they do not is refused, and the pair takes
-                                           // the side it is on (SelfCollision::set_refuse_crossing_pushes): in the
-                                           // armpit above, self-contact pushed the layers back through each other
-                                           // after the body had pushed them apart ("body: 8 -> 0 crossings, self: 0 ->
-                                           // 8"). It frees that case (70.6 / 94.1 -> 100 / 100%, with no tangle
-                                           // retest). Off: at 10 mm the t-shirt on 61_03 went 100 -> 69.9% of HR
-                                           // frames clean (the forearm pressed across the trunk pushes the sleeve
-                                           // through the shirt farther than a 10 mm face, so the faces around the pair
-                                           // no longer intersect and the push back is refused; refusing only pairs
-                                           // whose side was taken from intersecting faces: 69.1%).
-                                           // 30 mm matrix (LR / 2nd run, as above): dress_layered 60_02 100 / 97.8 ->
-                                           // 100 / 100%, skirt_tiered 61_03 100 / 86.0 -> 100 / 100%, skirt_tiered
-                                           // 131_01 76.5 / 75.7 -> 61.8 / 75.0%, the other 21 clips as clean as before;
-                                           // 10 mm skirt_pleated 131_01 at friction 0.3 / 0.30001 / 0.30002: HR 86.0 /
-                                           // 91.2 / 89.7 -> 89.7 / 100 / 89.0%. LR seconds per frame on the matrix
-                                           // +2.7% on average, +6% at most (sweeps run one after the other)
+  bool self_refuse_crossing_push =
+      false;            // a self-contact push back to a pair's remembered side that would make the
+                        // pair's faces intersect where they do not is refused, and the pair takes
+                        // the side it is on, where a body contact moved one of the pair's vertices
+                        // in this iteration (SelfCollision::set_refuse_crossing_pushes and
+                        // set_body_moved): in the armpit above, self-contact pushed the layers back
+                        // through each other after the body had pushed them apart ("body: 8 -> 0
+                        // crossings, self: 0 -> 8"). It frees that case (70.6 / 94.1 -> 100 / 100%,
+                        // with no tangle retest). Refusing such pushes of every pair, the first
+                        // version, cost the 10 mm t-shirt on 61_03 (HR 100 -> 69.9% of frames
+                        // clean: the forearm held across the trunk pushes the sleeve through the
+                        // shirt farther than a 10 mm face, the faces around the pair no longer
+                        // intersect, and the push back was refused); with the body's cue 100%.
+                        // The first version on the 30 mm matrix (LR / 2nd run, as above):
+                        // dress_layered 60_02 100 / 97.8 -> 100 / 100%, skirt_tiered 61_03 100 / 86.0
+                        // -> 100 / 100%, skirt_tiered 131_01 76.5 / 75.7 -> 61.8 / 75.0%, the other
+                        // 21 clips as clean as before, LR seconds per frame +2.7% on average (+6% at
+                        // most); 10 mm skirt_pleated 131_01 at friction 0.3 / 0.30001 / 0.30002: HR
+                        // 86.0 / 91.2 / 89.7 -> 89.7 / 100 / 89.0% (with the body's cue, 0.30002:
+                        // 89.7%). Off until the version with the cue has been run on the matrix
   int self_passes = 1;  // self-contact Gauss-Seidel passes per iteration (stops early when none is violated). More
                         // passes clear a sphere drape at compression_pd_exponent 1, but not garments: on the 11
                         // matrix clips above at 1, 2 passes against 1 left fewer frames free of self-intersections
@@ -663,6 +666,7 @@ class ClothSolver {
   std::vector<char> redetected_;  // per vertex: its path was redetected since the last detection
   int since_detect_ = 1 << 30;  // substeps since the last detection
   int detect_interval_ = 1;     // substeps the last detection covers (self_detect_every or fewer for fast cloth)
+  std::vector<char> body_moved_;  // per vertex, 1: moved by a body contact this iteration (self-contact reads it)
   bool tangle_test_due_ = true;  // the next detection also runs the tangle test (once per frame and on cue)
   const GuideTracker* tracker_ = nullptr;
   const gdsr::Points3 *guide_from_ = nullptr, *guide_to_ = nullptr;

@@ -711,6 +711,18 @@ TEST_CASE("self-collision: a push back across that would make the faces intersec
   CHECK(sc->num_sides_corrected() == 0);
   CHECK(y(3, 1) == doctest::Approx(thickness).epsilon(1e-9));
   CHECK(gdsr::self_intersections(y, F).pairs == 0);
+  // Told which vertices body contacts moved this iteration, only their pairs' pushes are refused.
+  for (const char centre_moved : {0, 1}) {
+    CAPTURE(static_cast<int>(centre_moved));
+    std::vector<char> body_moved(8, 0);
+    body_moved[3] = centre_moved;
+    const auto told = detected_pressed(F, pressed, slack, thickness, true);
+    told->set_body_moved(&body_moved);
+    Points3 u = x;
+    told->project(u, winv, thickness);
+    CHECK(told->num_sides_corrected() == centre_moved);
+    CHECK(u(3, 1) == (centre_moved ? 0.001 : doctest::Approx(-thickness).epsilon(1e-9)));
+  }
   // A pair that is still crossing is pushed back as before (the push undoes the crossing).
   Points3 z = pressed;
   sim::SelfCollision again(F, 8);
