@@ -199,6 +199,8 @@ class SelfCollision {
   bool faces_cross(const gdsr::Points3& x, const int* fa, int na, const int* fb, int nb) const;
   bool faces_cross(const gdsr::Points3& x, const VT& c) const;
   bool faces_cross(const gdsr::Points3& x, const EE& c) const;
+  // True if `push` would make the pair's faces intersect where they do not now; x is left as it was.
+  template <class Pair> bool push_makes_crossing(gdsr::Points3& x, const Pair& c, const PairPush& push) const;
   bool touches(const VT& c) const { return moved_v_[c.v] | moved_f_[c.f]; }
   bool touches(const EE& c) const { return moved_e_[c.a] | moved_e_[c.b]; }
   void mark_moved(const PairPush& push);

@@ -154,30 +154,25 @@ bool SelfCollision::faces_cross(const Points3& x, const EE& c) const {
   return faces_cross(x, edge_faces_[c.a].data(), 2, edge_faces_[c.b].data(), 2);
 }
 
-namespace {
-// True if `push` would make the pair's faces intersect where they do not now; x is left as it was.
-template <class Pair, class Cross>
-bool push_makes_crossing(Points3& x, const Pair& c, const Cross& cross, const gdsr::Vec3* d, const int* v) {
-  if (cross(x, c)) return false;  // crossing already: pushing back undoes it
+template <class Pair> bool SelfCollision::push_makes_crossing(Points3& x, const Pair& c, const PairPush& push) const {
+  if (faces_cross(x, c)) return false;  // crossing already: pushing back undoes it
   Vec3 kept[4];
-  for (int k = 0; k < 4; ++k) kept[k] = x.row(v[k]), x.row(v[k]) += d[k].transpose();
-  const bool made = cross(x, c);
-  for (int k = 0; k < 4; ++k) x.row(v[k]) = kept[k].transpose();
+  for (int k = 0; k < 4; ++k) kept[k] = x.row(push.v[k]);
+  push.apply(x);
+  const bool made = faces_cross(x, c);
+  for (int k = 0; k < 4; ++k) x.row(push.v[k]) = kept[k].transpose();
   return made;
 }
-}  // namespace
 
 bool SelfCollision::refuse_crossing_push(Points3& x, VT& c, const PairPush& push) {
-  auto cross = [&](const Points3& y, const VT& p) { return faces_cross(y, p); };
-  if (!push_makes_crossing(x, c, cross, push.d, push.v)) return false;
+  if (!push_makes_crossing(x, c, push)) return false;
   c.side = static_cast<signed char>(-c.side);
   ++sides_corrected_;
   return true;
 }
 
 bool SelfCollision::refuse_crossing_push(Points3& x, EE& c, const PairPush& push) {
-  auto cross = [&](const Points3& y, const EE& p) { return faces_cross(y, p); };
-  if (!push_makes_crossing(x, c, cross, push.d, push.v)) return false;
+  if (!push_makes_crossing(x, c, push)) return false;
   const int i0 = edges_[c.a][0], i1 = edges_[c.a][1], j0 = edges_[c.b][0], j1 = edges_[c.b][1];
   double s = 0, t = 0;
   closest_segments(x.row(i0), x.row(i1), x.row(j0), x.row(j1), s, t);

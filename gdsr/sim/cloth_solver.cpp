@@ -270,8 +270,10 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
     p_.self_detect_every = static_cast<int>(std::min(longer, 1000.0));
     self_ = std::make_unique<SelfCollision>(F_, nv);
     self_->set_refuse_crossing_pushes(p_.self_refuse_crossing_push);
-    body_moved_.assign(nv, 0);
-    self_->set_body_moved(&body_moved_);
+    if (p_.self_refuse_crossing_push) {  // otherwise body_moved_ stays empty, and nothing keeps it
+      body_moved_.assign(nv, 0);
+      self_->set_body_moved(&body_moved_);
+    }
     motion_ = Points3::Zero(nv, 3);
   }
 }
