@@ -501,14 +501,18 @@ std::vector<Points3> skin_frames(const Rig& rig, const Skin& sk, const ToMetres&
 
 // Arm clearance (BodyOptions::arm_clearance). An arm is told from the rest of the body by
 // skin: a vertex belongs to an arm when its heaviest influence is a node under that upper arm.
-// Only arm vertices farther than kArmPartSeparation from the rest of the body at the build pose
-// are checked (the upper arm joins the trunk at the shoulder).
+// An arm vertex is checked against the rest of the body where the two were farther apart than
+// kArmPartSeparation at the build pose: everywhere for a vertex that far from all of it, and
+// for one near the shoulder only where its closest face has no corner that near it then (an
+// upper arm pressed across the belly, not the armpit's skin folding as the arm comes down).
 constexpr double kArmPartSeparation = 0.15;      // metres, as ValidityOptions::pinch_separation
 constexpr double kArmTurnStep = 2 * M_PI / 180;  // search step; then 3 bisections (0.25 degrees)
 
 struct ArmParts {
   std::vector<int> rig_node;               // the two upper arms' nodes (none: not recognised)
   std::vector<std::vector<int>> vertices;  // per arm: its vertices checked for clearance
+  std::vector<std::vector<char>> near;     // per arm, per vertex: within kArmPartSeparation of `others` at rest
+  Points3 rest;                            // the build pose, metres
   Faces others;                            // faces with no corner on an arm: trunk, legs, head
   std::vector<char> rim;                   // per face of `others`: a corner on its open rim (the shoulders)
 };
@@ -547,9 +551,13 @@ ArmParts arm_parts(const Rig& rig, const Skin& sk, const Points3& rest, const st
   for (const Eigen::Vector3i& t : others) parts.rim.push_back(on_rim[t[0]] || on_rim[t[1]] || on_rim[t[2]]);
   const ClosestPoints cp = BodyQuery(TriMesh{rest, parts.others}).closest(rest, /*smooth_normals=*/false);
   parts.vertices.resize(2);
+  parts.near.resize(2);
+  parts.rest = rest;
   for (Eigen::Index i = 0; i < nv; ++i)
-    if (arm_of[i] >= 0 && std::abs(cp.sdist(i)) > kArmPartSeparation)
+    if (arm_of[i] >= 0) {
       parts.vertices[arm_of[i]].push_back(static_cast<int>(i));
+      parts.near[arm_of[i]].push_back(std::abs(cp.sdist(i)) <= kArmPartSeparation);
+    }
   return parts;
 }
 
@@ -567,9 +575,16 @@ ArmGap arm_gap(const Points3& V, const ArmParts& parts, int a) {
   Points3 Q(static_cast<Eigen::Index>(vs.size()), 3);
   for (size_t k = 0; k < vs.size(); ++k) Q.row(static_cast<Eigen::Index>(k)) = V.row(vs[k]);
   const ClosestPoints cp = BodyQuery(TriMesh{V, parts.others}).closest(Q, /*smooth_normals=*/false, 0.3);
+  auto near_at_rest = [&](size_t k, int f) {
+    if (!parts.near[a][k]) return false;
+    for (int c = 0; c < 3; ++c)
+      if ((parts.rest.row(parts.others(f, c)) - parts.rest.row(vs[k])).norm() <= kArmPartSeparation) return true;
+    return false;
+  };
   ArmGap g;
   for (Eigen::Index k = 0; k < Q.rows(); ++k)
-    if (cp.face(k) >= 0 && !parts.rim[cp.face(k)] && cp.sdist(k) < g.gap) {
+    if (cp.face(k) >= 0 && !parts.rim[cp.face(k)] && cp.sdist(k) < g.gap &&
+        !near_at_rest(static_cast<size_t>(k), cp.face(k))) {
       g.gap = cp.sdist(k);
       g.point = Q.row(k).transpose();
       g.normal = cp.normal.row(k).transpose();

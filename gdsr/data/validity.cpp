@@ -204,12 +204,13 @@ double mean_distance(const Points3& a, const Points3& b) {
 std::string validity_per_frame_csv(const ValidityFigures& v) {
   std::string s =
       "frame,lr_pairs,hr_pairs,lr_depth_outside_pinches_mm,hr_depth_outside_pinches_mm,agreement_mm,lr_threaded,"
-      "hr_threaded\n";
+      "hr_threaded,body_crosses_itself\n";
   char buf[160];
   for (size_t t = 0; t < v.per_frame.size(); ++t) {
     const FrameValidity& f = v.per_frame[t];
-    std::snprintf(buf, sizeof buf, "%zu,%ld,%ld,%.2f,%.2f,%.2f,%ld,%ld\n", t, f.lr_pairs, f.hr_pairs, 1e3 * f.lr_depth,
-                  1e3 * f.hr_depth, 1e3 * f.agreement, f.lr_threaded, f.hr_threaded);
+    std::snprintf(buf, sizeof buf, "%zu,%ld,%ld,%.2f,%.2f,%.2f,%ld,%ld,%d\n", t, f.lr_pairs, f.hr_pairs,
+                  1e3 * f.lr_depth, 1e3 * f.hr_depth, 1e3 * f.agreement, f.lr_threaded, f.hr_threaded,
+                  f.body_crossing ? 1 : 0);
     s += buf;
   }
   return s;
@@ -290,6 +291,7 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
       const Points3& rest = d.body_frames[0];
       const bool crossing = body_crosses_itself(d.body_frames[t], d.body_faces, rest, opt.pinch_separation);
       v.body_crossing_frames += crossing;
+      v.per_frame[t].body_crossing = crossing;
       // One closest-point query per resolution serves the penetration and the threaded edges.
       const ClosestPoints lr_cp = body->closest(d.lr_frames[t], /*smooth_normals=*/false),
                           hr_cp = body->closest(d.hr_frames[t], /*smooth_normals=*/false);

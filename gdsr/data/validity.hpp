@@ -103,6 +103,7 @@ struct FrameValidity {
   double lr_depth = 0, hr_depth = 0;  // metres, deepest vertex under the body surface outside pinches (0: none)
   double agreement = 0;               // metres, mean |HR - upsampled LR|
   long lr_threaded = 0, hr_threaded = 0;  // edges of cloth threaded on the body (0 without a body)
+  bool body_crossing = false;             // two body parts intersect (see body_crossing_frames)
 };
 
 struct ValidityFigures {

@@ -257,6 +257,28 @@ TEST_CASE("body: an arm that passes through the hip in the motion is turned out 
   CHECK_THROWS_WITH_AS(load_body_sequence(walk, bad), doctest::Contains("arm_clearance"), std::runtime_error);
 }
 
+TEST_CASE("body: an upper arm pressed into the back near the shoulder is turned out too") {
+  // CMU 131_01 from 4.6 s: the walker swings an arm back and its upper arm, 12-19 cm out from
+  // the shoulder (too near the trunk at the T-pose to be checked everywhere), presses into the
+  // back 16-20 cm from where it was then. Only the trunk faces that were that far are checked
+  // for such vertices (the armpit's own skin folds as the arm comes down).
+  const std::string walk = std::string(GDSR_SHARED_DIR) + "/motions/cmu-walk/131_01.bvh";
+  BodyOptions as_file, cleared;
+  as_file.start_seconds = cleared.start_seconds = 4.6;
+  as_file.max_seconds = cleared.max_seconds = 0.4;
+  cleared.arm_clearance = 0.01;
+  const BodySequence a = load_body_sequence(walk, as_file), b = load_body_sequence(walk, cleared);
+  const int before = arm_crossing_frames(a), after = arm_crossing_frames(b);
+  MESSAGE("frames with an arm crossing the body: " << before << " as in the file, " << after << " turned; "
+                                                   << b.arm_turns.turned_frames() << " frames turned, up to "
+                                                   << b.arm_turns.max_degrees() << " degrees, "
+                                                   << b.arm_turns.still_inside_frames << " still inside");
+  CHECK(before >= 2);
+  CHECK(after == 0);
+  CHECK(b.arm_turns.turned_frames() >= before);
+  CHECK(b.arm_turns.max_degrees() <= 30);
+}
+
 TEST_CASE("body: a skeleton whose hips are not recognised says so") {
   // 01_03 with its thighs renamed: no hips, so no torso through hips and shoulders.
   const gdsr_test::TempDir dir("body_names");

@@ -70,7 +70,7 @@ TEST_CASE("gdsr: validity figures of a stretched, lifted sheet over a rising box
   }
   const std::string csv = gdsr::validity_per_frame_csv(v);
   CHECK(std::count(csv.begin(), csv.end(), '\n') == 5);
-  CHECK(csv.find("\n2,0,0,8.00,6.00,2.00,0,0\n") != std::string::npos);
+  CHECK(csv.find("\n2,0,0,8.00,6.00,2.00,0,0,0\n") != std::string::npos);
 
   // Without the body: no penetration figures, and the table says so.
   opt.body = false;
@@ -271,6 +271,10 @@ TEST_CASE("gdsr: validity counts the frames where the body crosses itself, and t
   opt.penetration_limit = 0.0025;
   const gdsr::ValidityFigures v = gdsr::measure_validity(d, opt);
   CHECK(v.body_crossing_frames == 1);  // frame 3 only
+  for (int t = 0; t < 4; ++t) CHECK(v.per_frame[t].body_crossing == (t == 3));
+  const std::string csv = gdsr::validity_per_frame_csv(v);  // the last column is body_crosses_itself
+  CHECK(csv.substr(csv.size() - 3) == ",1\n");              // frame 3, the last row
+  CHECK(csv.find(",1\n") == csv.size() - 3);
   CHECK(v.lr.pinch_frames == 2);       // frames 2 (8 mm, the hand) and 3 (3 mm, the arm)
   CHECK(v.lr.pinch_frames_in_body_crossings == 1);
   CHECK(v.hr.pinch_frames == 1);  // HR is 2 mm higher: 6 mm in frame 2, 1 mm in frame 3
@@ -448,11 +452,13 @@ TEST_CASE("gdsr: validity counts the frames where cloth is threaded on a body pa
             v.per_frame[2].hr_threaded ==
         0);
   const std::string csv = gdsr::validity_per_frame_csv(v);
-  CHECK(csv.find(",lr_threaded,hr_threaded\n") != std::string::npos);
+  CHECK(csv.find(",lr_threaded,hr_threaded,body_crosses_itself\n") != std::string::npos);
   CHECK(csv.find("\n1,") != std::string::npos);
   const size_t row1 = csv.find("\n1,") + 1;
   const std::string line1 = csv.substr(row1, csv.find('\n', row1) - row1);
-  CHECK(line1.substr(line1.rfind(',') + 1) == std::to_string(v.hr.max_threaded_edges));
+  const std::string tail = "," + std::to_string(v.hr.max_threaded_edges) + ",0";  // hr_threaded, body not crossing
+  CHECK(line1.size() > tail.size());
+  CHECK(line1.substr(line1.size() - tail.size()) == tail);
   // A deeper threshold than the 1 cm, or a part 6 mm thick (its middle 3 mm deep, as a chord
   // grazing a curved body dips in), counts none.
   opt.threaded_depth = 0.011;
