@@ -501,18 +501,21 @@ std::vector<Points3> skin_frames(const Rig& rig, const Skin& sk, const ToMetres&
 
 // Arm clearance (BodyOptions::arm_clearance). An arm is told from the rest of the body by
 // skin: a vertex belongs to an arm when its heaviest influence is a node under that upper arm.
-// An arm vertex is checked against the rest of the body where the two were farther apart than
-// kArmPartSeparation at the build pose: everywhere for a vertex that far from all of it, and
-// for one near the shoulder only where its closest face has no corner that near it then (an
-// upper arm pressed across the belly, not the armpit's skin folding as the arm comes down).
+// Only arm vertices farther than kArmPartSeparation from the rest of the body at the build pose
+// are checked (the upper arm joins the trunk at the shoulder).
+// Tried on 2026-12-06, not kept: checking the upper arm near the shoulder too, against the faces
+// that were not near it at the build pose (an upper arm swung into the back, CMU 131_01 frames
+// 96-97 from 2 s). On 131_01 the body crossed itself in 31 frames instead of 33, and the 30 mm cloth
+// stayed within the chaotic spread. On salsa 61_03 the armpit's own folds counted as inside: 37
+// frames were still inside after a 30 degree turn (5 before), and the 30 mm t-shirt had LR / 2nd-run
+// frames with cloth > 5 mm inside the body outside pinches 2 / 0 -> 10 / 7 (friction 0.3) and
+// 2 / 0 -> 9 / 11 (0.30002), deepest 14.5 -> 19.6 mm and 10.0 -> 27.5 mm.
 constexpr double kArmPartSeparation = 0.15;      // metres, as ValidityOptions::pinch_separation
 constexpr double kArmTurnStep = 2 * M_PI / 180;  // search step; then 3 bisections (0.25 degrees)
 
 struct ArmParts {
   std::vector<int> rig_node;               // the two upper arms' nodes (none: not recognised)
   std::vector<std::vector<int>> vertices;  // per arm: its vertices checked for clearance
-  std::vector<std::vector<char>> near;     // per arm, per vertex: within kArmPartSeparation of `others` at rest
-  Points3 rest;                            // the build pose, metres
   Faces others;                            // faces with no corner on an arm: trunk, legs, head
   std::vector<char> rim;                   // per face of `others`: a corner on its open rim (the shoulders)
 };
@@ -551,13 +554,9 @@ ArmParts arm_parts(const Rig& rig, const Skin& sk, const Points3& rest, const st
   for (const Eigen::Vector3i& t : others) parts.rim.push_back(on_rim[t[0]] || on_rim[t[1]] || on_rim[t[2]]);
   const ClosestPoints cp = BodyQuery(TriMesh{rest, parts.others}).closest(rest, /*smooth_normals=*/false);
   parts.vertices.resize(2);
-  parts.near.resize(2);
-  parts.rest = rest;
   for (Eigen::Index i = 0; i < nv; ++i)
-    if (arm_of[i] >= 0) {
+    if (arm_of[i] >= 0 && std::abs(cp.sdist(i)) > kArmPartSeparation)
       parts.vertices[arm_of[i]].push_back(static_cast<int>(i));
-      parts.near[arm_of[i]].push_back(std::abs(cp.sdist(i)) <= kArmPartSeparation);
-    }
   return parts;
 }
 
@@ -575,16 +574,9 @@ ArmGap arm_gap(const Points3& V, const ArmParts& parts, int a) {
   Points3 Q(static_cast<Eigen::Index>(vs.size()), 3);
   for (size_t k = 0; k < vs.size(); ++k) Q.row(static_cast<Eigen::Index>(k)) = V.row(vs[k]);
   const ClosestPoints cp = BodyQuery(TriMesh{V, parts.others}).closest(Q, /*smooth_normals=*/false, 0.3);
-  auto near_at_rest = [&](size_t k, int f) {
-    if (!parts.near[a][k]) return false;
-    for (int c = 0; c < 3; ++c)
-      if ((parts.rest.row(parts.others(f, c)) - parts.rest.row(vs[k])).norm() <= kArmPartSeparation) return true;
-    return false;
-  };
   ArmGap g;
   for (Eigen::Index k = 0; k < Q.rows(); ++k)
-    if (cp.face(k) >= 0 && !parts.rim[cp.face(k)] && cp.sdist(k) < g.gap &&
-        !near_at_rest(static_cast<size_t>(k), cp.face(k))) {
+    if (cp.face(k) >= 0 && !parts.rim[cp.face(k)] && cp.sdist(k) < g.gap) {
       g.gap = cp.sdist(k);
       g.point = Q.row(k).transpose();
       g.normal = cp.normal.row(k).transpose();

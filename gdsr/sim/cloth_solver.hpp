@@ -221,20 +221,7 @@ namespace sim {
 //     and CMU 01_01; skirt_short on 131_01, whose hand still passes, and 61_03; skirt_tiered and
 //     skirt_pleated on 131_02; skirt_pleated on 61_03; dress_layered on 131_01), HR too where
 //     measured (skirt_short and skirt_pleated on 131_01). Garments without pins: byte-identical.
-// 30: arm clearance (BodyOptions::arm_clearance) also checks the upper arm near the shoulder,
-//     against the faces that were not near it at the build pose: an upper arm pressed into the
-//     back or the ribs is turned out, where before only vertices 15 cm from the trunk at rest
-//     were checked (the kneel of CMU 131_01, frames 96-97). Frames where the body crosses itself
-//     (validity, body_crosses_itself) 33 -> 31 on 131_01 (2-6 s); the demo clips' arms, which hang
-//     within 10 mm of the ribs, are turned by up to 1.0 (01_01) and 1.8 (01_03) degrees. 30 mm
-//     cloth on 131_01 at friction 0.3 / 0.30001 / 0.30002, LR / 2nd-run frames free of
-//     self-intersections: pants 89.7 / 100, 100 / 100, 100 / 100 -> 100 / 100 at all three;
-//     skirt_pleated 80.1 / 100, 100 / 100, 100 / 100 -> 100 / 100, 100 / 100, 100 / 89.0;
-//     skirt_tiered 76.5 / 75.7, 62.5 / 75.0, 75.7 / 76.5 -> 77.2 / 76.5, 75.7 / 75.0, 76.5 / 60.3;
-//     t-shirt frames with cloth > 5 mm inside the body outside pinches 95 / 92, 101 / 89, 19 / 11
-//     -> 61 / 68, 103 / 100, 10 / 8; skirt_short, dress_layered as clean as before. Within the
-//     chaotic spread on the cloth; kept for the body, which no longer crosses itself there.
-inline constexpr int kSolverRevision = 30;
+inline constexpr int kSolverRevision = 29;
 
 struct SimParams {
   int substeps = 20;                // per body frame
