@@ -472,6 +472,7 @@ struct PreviewArgs {
   bool penetration = false;    // paint the faces inside the body (outside pinches magenta, pinched cyan)
   double pinch_gap_mm = default_pinch_gap_mm();  // the crease rule of `data check`
   std::string view = "front";  // where the camera is, relative to the body's first pose (Y-up, facing +z)
+  int layer = -1;              // >= 0: draw only this cloth layer's faces (0: innermost)
 };
 
 // Preview cameras: direction and image up, the camera on the body's side named (the body's
@@ -549,12 +550,13 @@ void add_marked(const gdsr::TriMesh& g, const std::vector<int>& mark, const std:
   }
 }
 
-// X-ray: the faces marked kPinched or kInBody drawn over img (rendered with opt) at 65%
-// opacity, so that the body that hides them does not.
+// X-ray: the faces marked kPinched, kInBody or kIntersecting drawn over img (rendered with opt)
+// at 65% opacity, so that the body or the cloth that hides them does not (a knot between the
+// layers of a tiered skirt lies under its outer tier).
 void draw_through(const gdsr::TriMesh& g, std::vector<int> mark, const std::array<cv::Vec3b, kMarks>& colour,
                   const gdsr::RenderOptions& opt, cv::Mat& img) {
   for (int& m : mark)
-    if (m != kPinched && m != kInBody) m = -1;
+    if (m == kPlain) m = -1;
   std::vector<gdsr::TriMesh> parts;
   std::vector<cv::Vec3b> colours;
   add_marked(g, mark, colour, parts, colours);
@@ -567,6 +569,20 @@ void draw_through(const gdsr::TriMesh& g, std::vector<int> mark, const std::arra
   blend.copyTo(img, ~empty);
 }
 
+// The faces of g (and their marks) whose first corner lies on cloth layer `layer` of `layers`
+// (per vertex; empty: one layer, 0).
+void keep_layer(int layer, const std::vector<int>& layers, gdsr::TriMesh& g, std::vector<int>& mark) {
+  int n = 0;
+  for (int f = 0; f < g.F.rows(); ++f) {
+    const int l = layers.empty() ? 0 : layers[g.F(f, 0)];
+    if (l != layer) continue;
+    g.F.row(n) = g.F.row(f);
+    mark[n++] = mark[f];
+  }
+  g.F.conservativeResize(n, 3);
+  mark.resize(n);
+}
+
 void run_preview(const PreviewArgs& a) {
   const gdsr::Dataset d = gdsr::load_dataset(a.data);
   const int T = d.manifest.frames;
@@ -574,6 +590,12 @@ void run_preview(const PreviewArgs& a) {
   const int t = a.frame < 0 ? T - 1 : a.frame;
   if (t >= T)
     gdsr::fail("--frame", std::to_string(t) + " out of range (" + a.data + " has " + std::to_string(T) + " frames)");
+  const int layers = std::min(d.lr.num_layers(), d.hr.num_layers());
+  if (a.layer >= layers)
+    gdsr::fail("--layer",
+               std::to_string(a.layer) + " out of range (" + a.data + " has " +
+                   (layers == 1 ? "one layer: 0)"
+                                : std::to_string(layers) + " layers: 0-" + std::to_string(layers - 1) + ")"));
   const gdsr::TriMesh lr{d.lr_frames[t], d.lr.F}, hr{d.hr_frames[t], d.hr.F};
   // One camera for both images: framed on the HR garment (and the body around it).
   gdsr::Points3 all = hr.V;
@@ -589,11 +611,23 @@ void run_preview(const PreviewArgs& a) {
   if (a.penetration && !d.has_body()) gdsr::fail("--penetration", a.data + " has no body");
   const std::string view_note = a.view == "front" ? "" : ", " + a.view;
   std::string lr_note = view_note, hr_note = view_note;
-  auto render = [&](const char* name, const gdsr::TriMesh& g, const cv::Vec3b& c, std::string& note) {
+  auto render = [&](const char* name, const gdsr::TriMesh& whole, const std::vector<int>& layer_of, const cv::Vec3b& c,
+                    std::string& note) {
     std::vector<gdsr::TriMesh> meshes = with_body;
     std::vector<cv::Vec3b> colours(with_body.size(), body_c);
-    std::vector<int> mark(g.F.rows(), kPlain);
-    if (a.intersections) note += ", " + std::to_string(mark_intersections(g, mark)) + " faces intersect";
+    std::vector<int> mark(whole.F.rows(), kPlain);
+    // Marked on the whole garment (a layer's faces crossing another layer's count), then cut to --layer.
+    const int crossing = a.intersections ? mark_intersections(whole, mark) : 0;
+    gdsr::TriMesh g = whole;
+    if (a.layer >= 0) keep_layer(a.layer, layer_of, g, mark);
+    if (a.intersections) {
+      const long shown = std::count(mark.begin(), mark.end(), int{kIntersecting});
+      note += a.layer >= 0 ? ", " + std::to_string(shown) + "/" + std::to_string(crossing) + " intersect"
+                           : ", " + std::to_string(crossing) + " faces intersect";
+      std::printf("%s: %d faces in intersecting pairs", name, crossing);
+      if (a.layer >= 0) std::printf(", %ld of them on layer %d", shown, a.layer);
+      std::printf("\n");
+    }
     if (a.penetration) {
       const InBody in = mark_penetration(d, t, g, 1e-3 * a.pinch_gap_mm, mark);
       note += ", " + std::to_string(in.faces) + " in body (" + std::to_string(in.pinched) + " pinched)";
@@ -608,10 +642,14 @@ void run_preview(const PreviewArgs& a) {
     draw_through(g, mark, colour, opt, img);
     return img;
   };
-  const cv::Mat lr_img = render("LR", lr, lr_c, lr_note), hr_img = render("HR", hr, hr_c, hr_note);
-  const cv::Mat img = gdsr::side_by_side(
-      {lr_img, hr_img}, {"LR " + std::to_string(lr.num_vertices()) + " verts, frame " + std::to_string(t) + lr_note,
-                         "HR " + std::to_string(hr.num_vertices()) + " verts, frame " + std::to_string(t) + hr_note});
+  const cv::Mat lr_img = render("LR", lr, d.lr.layer, lr_c, lr_note),
+                hr_img = render("HR", hr, d.hr.layer, hr_c, hr_note);
+  auto what = [&](const gdsr::TriMesh& g) {
+    return a.layer >= 0 ? "layer " + std::to_string(a.layer) : std::to_string(g.num_vertices()) + " verts";
+  };
+  const cv::Mat img =
+      gdsr::side_by_side({lr_img, hr_img}, {"LR " + what(lr) + ", frame " + std::to_string(t) + lr_note,
+                                            "HR " + what(hr) + ", frame " + std::to_string(t) + hr_note});
   gdsr::write_png_atomic(a.out, img);
   std::printf("wrote %s (%d x %d): frame %d of %d, LR %d / HR %d vertices\n", a.out.c_str(), img.cols, img.rows, t, T,
               lr.num_vertices(), hr.num_vertices());
@@ -896,7 +934,8 @@ void add_data_command(CLI::App& app) {
   prev->add_option("--out", pv->out, "PNG file to write")->required();
   prev->add_option("--size", pv->size, "pixels per image side")->capture_default_str()->check(CLI::Range(16, 8192));
   prev->add_flag("!--no-body", pv->body, "leave the body out");
-  prev->add_flag("--intersections", pv->intersections, "paint faces in self-intersecting pairs (CGAL) red");
+  prev->add_flag("--intersections", pv->intersections,
+                 "paint faces in self-intersecting pairs (CGAL) red, drawn through the cloth and body that hide them");
   prev->add_flag("--penetration", pv->penetration,
                  "paint faces with a corner more than 5 mm inside the body magenta, cyan where a second body part "
                  "or a closed crease pinches it (the rule of `data check`), drawn through the body");
@@ -906,6 +945,10 @@ void add_data_command(CLI::App& app) {
   prev->add_option("--view", pv->view, "camera on the body's front, back, left, right or top")
       ->capture_default_str()
       ->check(CLI::IsMember(view_names));
+  prev->add_option("--layer", pv->layer,
+                   "draw only this cloth layer (0: innermost; -1: all), to see between the layers of a layered garment")
+      ->capture_default_str()
+      ->check(CLI::Range(-1, 1 << 20));
   prev->callback([pv]() { run_preview(*pv); });
 
   auto imp = std::make_shared<ImportArgs>();

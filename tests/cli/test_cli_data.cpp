@@ -3,6 +3,7 @@
 #include "gdsr/data/dataset.hpp"
 #include "gdsr/geometry/mesh_ops.hpp"
 #include "gdsr/geometry/obj_io.hpp"
+#include "gdsr/geometry/self_intersections.hpp"
 #include "tests/support/cli_run.hpp"
 #include "tests/support/data_fixtures.hpp"
 
@@ -15,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
@@ -254,6 +256,107 @@ TEST_CASE("cli data: preview --penetration paints and counts the faces in the bo
       gdsr_run(dir, "data preview --data '" + (dir / "nobody") + "' --penetration --out '" + (dir / "nb.png") + "'"),
       "--penetration");
   CHECK_FALSE(fs::exists(dir / "nb.png"));
+}
+
+// Three vertical sheets (0.3 m, n x n vertices, facing the front camera +z) as one garment,
+// layer k at z = z[k]; the middle one dented back through the innermost at its centre, behind
+// the outer sheet that hides both from the front. No body.
+static gdsr::GarmentMesh three_layers(int n, const double z[3]) {
+  gdsr::GarmentMesh g;
+  for (int k = 0; k < 3; ++k) {
+    gdsr::GarmentMesh s = gdsr_test::grid_garment(gdsr_test::GridSpec(n - 1, n - 1, 0.3, 0.3).layer(k));
+    s.V.col(2).array() += z[k];
+    const int nv = static_cast<int>(g.V.rows()), nuv = static_cast<int>(g.UV.rows());
+    auto stack = [](auto& a, const auto& b) {
+      auto top = a;
+      a.resize(top.rows() + b.rows(), b.cols());
+      a << top, b;
+    };
+    stack(g.V, s.V);
+    stack(g.UV, gdsr::Points2(s.UV.rowwise() + Eigen::RowVector2d(0.5 * k, 0)));
+    stack(g.F, gdsr::Faces(s.F.array() + nv));
+    stack(g.FUV, gdsr::Faces(s.FUV.array() + nuv));
+    for (int u : s.uv_to_vertex) g.uv_to_vertex.push_back(u + nv);
+    g.layer.insert(g.layer.end(), s.layer.begin(), s.layer.end());
+  }
+  const int per = n * n;
+  for (int v = per; v < 2 * per; ++v)
+    if ((g.V.row(v).head<2>() - Eigen::RowVector2d(0.15, 0.15)).norm() < 0.06) g.V(v, 2) = -0.01;
+  return g;
+}
+
+TEST_CASE("cli data: preview draws the faces of a knot hidden under an outer layer, and one layer alone") {
+  TempDir dir("cli_preview_layers");
+  const double z[3] = {0.0, 0.01, 0.03};
+  gdsr::Dataset d;
+  d.lr = three_layers(7, z);
+  d.hr = three_layers(13, z);
+  d.lr_frames.assign(2, d.lr.V);
+  d.hr_frames.assign(2, d.hr.V);
+  d.corr = gdsr::compute_correspondence(d.lr, d.hr);
+  d.raster = gdsr::rasterize_uv(d.hr.UV, d.hr.FUV, 64, 64, 2);
+  d.manifest.garment = "three sheets";
+  gdsr::update_manifest_counts(d);
+  gdsr::write_dataset(dir / "ds", d);
+  auto preview = [&](const std::string& flags, const std::string& png) {
+    const Run r =
+        gdsr_run(dir, "data preview --data '" + (dir / "ds") + "' --size 160 --out '" + (dir / png) + "' " + flags);
+    CHECK(r.status == 0);
+    return r.out + r.err;
+  };
+  // Pixels under the caption bar (28 px) turned red from `plain` to `marked`: green falls, red
+  // does not (both cloth colours, shaded, and the x-ray's blend).
+  auto reddened = [&](const std::string& plain, const std::string& marked) {
+    const cv::Mat a = cv::imread(dir / plain, cv::IMREAD_COLOR), b = cv::imread(dir / marked, cv::IMREAD_COLOR);
+    REQUIRE_FALSE(a.empty());
+    REQUIRE(a.size() == b.size());
+    int n = 0;
+    for (int y = 28; y < a.rows; ++y)
+      for (int x = 0; x < a.cols; ++x) {
+        const cv::Vec3b p = a.at<cv::Vec3b>(y, x), q = b.at<cv::Vec3b>(y, x);
+        n += q[1] + 25 < p[1] && q[2] + 25 >= p[2];
+      }
+    return n;
+  };
+  // The dent crosses layer 0: counted by the yardstick itself, not by the preview.
+  REQUIRE(gdsr::self_intersections(d.lr.V, d.lr.F).pairs > 0);
+  preview("", "plain.png");
+  // The outer sheet hides the knot from the front; it is drawn through it.
+  // The yardstick's faces in intersecting pairs, all and per layer (of their first corner).
+  std::set<int> crossing;
+  for (const auto& [f, g] : gdsr::self_intersections(d.lr.V, d.lr.F, true).list) crossing.insert({f, g});
+  int on_layer[3] = {0, 0, 0};
+  for (int f : crossing) ++on_layer[d.lr.layer[d.lr.F(f, 0)]];
+  CHECK(preview("--intersections", "all.png")
+            .find("LR: " + std::to_string(crossing.size()) + " faces in intersecting pairs\n") != std::string::npos);
+  CHECK(reddened("plain.png", "all.png") > 0);
+  // Layer 2 alone crosses nothing: no red (drawn through, the other layers' faces would show);
+  // layers 0 and 1 alone show their faces of the knot.
+  preview("--layer 2", "l2.png");
+  preview("--intersections --layer 2", "l2i.png");
+  CHECK(reddened("l2.png", "l2i.png") == 0);
+  CHECK(on_layer[2] == 0);
+  CHECK(on_layer[0] > 0);
+  CHECK(on_layer[1] > 0);
+  for (const std::string layer : {"0", "1"}) {
+    preview("--layer " + layer, "l" + layer + ".png");
+    CHECK(preview("--intersections --layer " + layer, "l" + layer + "i.png")
+              .find("LR: " + std::to_string(crossing.size()) + " faces in intersecting pairs, " +
+                    std::to_string(on_layer[std::stoi(layer)]) + " of them on layer " + layer) != std::string::npos);
+    CHECK(reddened("l" + layer + ".png", "l" + layer + "i.png") > 0);
+  }
+  check_one_line_error(
+      gdsr_run(dir, "data preview --data '" + (dir / "ds") + "' --layer 3 --out '" + (dir / "bad.png") + "'"),
+      "has 3 layers: 0-2");
+  CHECK_FALSE(fs::exists(dir / "bad.png"));
+  // A one-layer dataset has layer 0 only.
+  gdsr::write_dataset(dir / "wave", gdsr_test::wave_dataset(2));
+  CHECK(
+      gdsr_run(dir, "data preview --data '" + (dir / "wave") + "' --layer 0 --size 64 --out '" + (dir / "w.png") + "'")
+          .status == 0);
+  check_one_line_error(
+      gdsr_run(dir, "data preview --data '" + (dir / "wave") + "' --layer 1 --out '" + (dir / "w1.png") + "'"),
+      "one layer: 0");
 }
 
 TEST_CASE("cli data: make warns when a skeleton's hips and shoulders are not recognised") {
