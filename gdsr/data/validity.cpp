@@ -66,6 +66,31 @@ void measure_intersections(const std::vector<Points3>& frames, const Faces& F, i
   r.si_median_pairs = median(pairs);
 }
 
+// Knots of one resolution (ResolutionValidity::si_knots) from the checked frames' pair counts in
+// rows (-1: not checked); the body's share when `body` (rows[t].body_crossing measured).
+void count_knots(const std::vector<FrameValidity>& rows, long FrameValidity::*pairs_field, bool body,
+                 ResolutionValidity& r) {
+  r.si_knots = 0;
+  r.si_knots_from_body_crossings = body ? 0 : -1;
+  r.si_knot_frames_from_body_crossings = body ? 0 : -1;
+  bool in_knot = false, from_body = false;
+  for (const FrameValidity& f : rows) {
+    const long pairs = f.*pairs_field;
+    if (pairs < 0) continue;  // not checked (stride): runs join over it
+    if (pairs == 0) {
+      in_knot = false;
+      continue;
+    }
+    if (!in_knot) {
+      in_knot = true;
+      ++r.si_knots;
+      from_body = body && f.body_crossing;
+      r.si_knots_from_body_crossings += from_body;
+    }
+    r.si_knot_frames_from_body_crossings += from_body;
+  }
+}
+
 // Whether the way out of the body for garment vertex i (inside it), from its closest body point
 // on along the direction from the vertex to that point, meets the body again within `gap`
 // metres: the cloth lies in a crease closed to less than that (a bent elbow's crook).
@@ -313,6 +338,8 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
   measure_intersections(d.lr_frames, d.lr.F, opt.intersection_stride, v.lr, v.per_frame, &FrameValidity::lr_pairs);
   if (progress) progress(T + 1, steps);
   measure_intersections(d.hr_frames, d.hr.F, opt.intersection_stride, v.hr, v.per_frame, &FrameValidity::hr_pairs);
+  count_knots(v.per_frame, &FrameValidity::lr_pairs, v.body_measured, v.lr);
+  count_knots(v.per_frame, &FrameValidity::hr_pairs, v.body_measured, v.hr);
   if (progress) progress(steps, steps);
   return v;
 }
@@ -348,7 +375,8 @@ nlohmann::json resolution_json(const ResolutionValidity& r, bool body) {
                         {"max_pairs", r.si_max_pairs},
                         {"max_pairs_frame", r.si_max_frame},
                         {"degenerate_faces", r.si_degenerate_faces},
-                        {"skipped_faces", r.si_skipped_faces}}},
+                        {"skipped_faces", r.si_skipped_faces},
+                        {"knots", r.si_knots}}},
                       {"strain",
                        {{"E_u", r.strain.E_u},
                         {"E_v", r.strain.E_v},
@@ -360,6 +388,10 @@ nlohmann::json resolution_json(const ResolutionValidity& r, bool body) {
                         {"torn_frames", r.torn_frames},
                         {"torn_vertices", r.torn_vertices}}},
                       {"mean_curvature_1_m", r.mean_curvature}};
+  if (body) {
+    j["self_intersection"]["knots_from_body_crossings"] = r.si_knots_from_body_crossings;
+    j["self_intersection"]["knot_frames_from_body_crossings"] = r.si_knot_frames_from_body_crossings;
+  }
   if (body)
     j["body"] = {{"max_penetration_m", r.max_penetration},
                  {"max_penetration_frame", r.max_penetration_frame},
@@ -396,6 +428,12 @@ ResolutionValidity resolution_from_json(const nlohmann::json& j, bool body, cons
   r.si_max_frame = take<int>(si, "max_pairs_frame", w);
   r.si_degenerate_faces = take<long>(si, "degenerate_faces", w);
   r.si_skipped_faces = take<long>(si, "skipped_faces", w);
+  // Manifests written before knots were counted: not measured.
+  r.si_knots = si.contains("knots") ? take<int>(si, "knots", w) : -1;
+  r.si_knots_from_body_crossings =
+      si.contains("knots_from_body_crossings") ? take<int>(si, "knots_from_body_crossings", w) : -1;
+  r.si_knot_frames_from_body_crossings =
+      si.contains("knot_frames_from_body_crossings") ? take<int>(si, "knot_frames_from_body_crossings", w) : -1;
   const auto st = take<nlohmann::json>(j, "strain", where);
   r.strain.E_u = take<double>(st, "E_u", where + "strain.");
   r.strain.E_v = take<double>(st, "E_v", where + "strain.");
@@ -516,6 +554,16 @@ std::string validity_table(const ValidityFigures& v) {
   line("  %-40s %14.1f %14.1f\n", "self-intersection: median pairs", v.lr.si_median_pairs, v.hr.si_median_pairs);
   line("  %-40s %8ld (f%3d) %8ld (f%3d)\n", "self-intersection: max pairs (frame)", v.lr.si_max_pairs,
        v.lr.si_max_frame, v.hr.si_max_pairs, v.hr.si_max_frame);
+  if (v.lr.si_knots >= 0 && v.hr.si_knots >= 0)
+    line("  %-40s %14d %14d\n", "self-intersection: knots (runs of frames)", v.lr.si_knots, v.hr.si_knots);
+  if (v.body_crossing_frames >= 0 && v.lr.si_knots_from_body_crossings >= 0 && v.hr.si_knots_from_body_crossings >= 0) {
+    auto share = [](const ResolutionValidity& r) {
+      char b[48];
+      std::snprintf(b, sizeof b, "%d (%d fr)", r.si_knots_from_body_crossings, r.si_knot_frames_from_body_crossings);
+      return std::string(b);
+    };
+    line("  %-40s %14s %14s\n", "  begun where the body crosses itself", share(v.lr).c_str(), share(v.hr).c_str());
+  }
   if (v.lr.si_degenerate_faces + v.hr.si_degenerate_faces + v.lr.si_skipped_faces + v.hr.si_skipped_faces > 0)
     line("  %-40s %6ld / %5ld %6ld / %5ld\n", "  degenerate / non-manifold faces skipped", v.lr.si_degenerate_faces,
          v.lr.si_skipped_faces, v.hr.si_degenerate_faces, v.hr.si_skipped_faces);

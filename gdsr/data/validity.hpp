@@ -74,6 +74,13 @@ struct ResolutionValidity {
   long si_degenerate_faces = 0;  // max over checked frames of degenerate (collinear) faces
   long si_skipped_faces = 0;     // non-manifold faces left out of the test (same every frame)
   double si_clean_fraction() const { return si_frames > 0 ? static_cast<double>(si_clean_frames) / si_frames : 0; }
+  // Knots: runs of consecutive checked frames with intersecting pairs (cloth that stays through
+  // itself for 30 frames is one knot), and those whose first frame has the body crossing itself
+  // (body_crossing_frames), with their checked frames: where the body leaves the cloth no room,
+  // apart from where the solver let it through. -1: not measured (no body, or an older manifest).
+  int si_knots = 0;
+  int si_knots_from_body_crossings = -1;
+  int si_knot_frames_from_body_crossings = -1;
   // strain, means over frames of the per-frame means over triangles
   StrainEnergies strain;
   double max_edge_stretch = 0;      // longest edge / pattern length, max over frames

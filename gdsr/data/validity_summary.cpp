@@ -18,6 +18,17 @@ bool within_ratio(double r, double limit) { return std::isnan(r) || (r <= limit 
 // "0.84x", or "-" for NaN (not measured: datasets made before the split, or nothing in LR).
 std::string ratio_or_dash(double r) { return std::isnan(r) ? "-" : format("%.2fx", r, 0); }
 
+// " (knots 1 / 2, 1 / 1 from body crossings)" when a resolution has knots (ResolutionValidity::si_knots).
+std::string knots(const ValidityFigures& v) {
+  const ResolutionValidity &L = v.lr, &H = v.hr;
+  if (L.si_knots < 0 || H.si_knots < 0 || L.si_knots + H.si_knots == 0) return "";
+  std::string s = " (knots " + std::to_string(L.si_knots) + " / " + std::to_string(H.si_knots);
+  if (v.body_crossing_frames >= 0 && L.si_knots_from_body_crossings >= 0 && H.si_knots_from_body_crossings >= 0)
+    s += ", " + std::to_string(L.si_knots_from_body_crossings) + " / " +
+         std::to_string(H.si_knots_from_body_crossings) + " from body crossings";
+  return s + ")";
+}
+
 }  // namespace
 
 std::vector<std::string> failed_criteria(const ValidityFigures& v, const ValidityLimits& lim) {
@@ -55,7 +66,7 @@ std::string validity_summary_markdown(const std::vector<ValiditySummaryRow>& row
     std::string fails;
     for (const std::string& c : failed_criteria(v, lim)) fails += (fails.empty() ? "" : ", ") + c;
     s += "| " + row.name + " | " + row.garment + " | " + std::to_string(v.frames) + " | " +
-         format("%.1f / %.1f%%", 100 * L.si_clean_fraction(), 100 * H.si_clean_fraction()) + " | " +
+         format("%.1f / %.1f%%", 100 * L.si_clean_fraction(), 100 * H.si_clean_fraction()) + knots(v) + " | " +
          format("%.4f / %.4f", L.strain.E_u, H.strain.E_u) + " | " + format("%.4f / %.4f", L.strain.E_v, H.strain.E_v) +
          " | " + format("%.4f / %.4f", L.strain.E_uv, H.strain.E_uv) + " | " + ratio_or_dash(v.stretched_ratio_u()) +
          ", " + ratio_or_dash(v.stretched_ratio_v()) + " | " + format("%.0f / %.0f", L.torn_frames, H.torn_frames) +

@@ -300,6 +300,67 @@ TEST_CASE("gdsr: validity counts the frames where the body crosses itself, and t
   CHECK(gdsr::validity_table(o).find("crosses itself") == std::string::npos);
 }
 
+TEST_CASE("gdsr: validity counts knots, runs of frames through itself, and those begun where the body crosses itself") {
+  // Seven frames of the rising box's sheet (1 mm under it: no pinch); an "arm" 0.4 m away,
+  // pushed into the box's side in frames 3-4 (the body crosses itself). The HR sheet is wrapped
+  // 1.25 times round a cylinder, through itself, in frames 1, 3, 4 and 6: three knots, {1},
+  // {3, 4} (begun in a body crossing) and {6}; LR stays clean.
+  gdsr::Dataset d = gdsr_test::stretched_dataset(std::vector<double>(7, 0.001));
+  const gdsr::TriMesh arm_far = gdsr_test::box(0.7, 0.8, 0.13, 0.17, -0.03, -0.005),
+                      arm_in = gdsr_test::box(0.19, 0.29, 0.13, 0.17, -0.03, -0.005);
+  gdsr::Faces F(24, 3);
+  F << d.body_faces, (arm_far.F.array() + 8).matrix();
+  d.body_faces = F;
+  for (size_t t = 0; t < d.body_frames.size(); ++t) {
+    Points3 V(16, 3);
+    V << d.body_frames[t], (t == 3 || t == 4 ? arm_in : arm_far).V;
+    d.body_frames[t] = V;
+  }
+  const Points3 wrapped = gdsr_test::grid_garment(gdsr_test::GridSpec(8, 8, 0.3, 0.3).bent(2.5 * M_PI)).V;
+  REQUIRE(wrapped.rows() == d.hr.V.rows());
+  for (int t : {1, 3, 4, 6}) d.hr_frames[t] = wrapped;
+  const gdsr::ValidityFigures v = gdsr::measure_validity(d);
+  REQUIRE(v.body_crossing_frames == 2);
+  CHECK(v.hr.si_clean_frames == 3);
+  CHECK(v.hr.si_knots == 3);
+  CHECK(v.hr.si_knots_from_body_crossings == 1);
+  CHECK(v.hr.si_knot_frames_from_body_crossings == 2);
+  CHECK(v.lr.si_knots == 0);
+  CHECK(v.lr.si_knots_from_body_crossings == 0);
+  CHECK(v.lr.si_knot_frames_from_body_crossings == 0);
+  // Every 2nd frame (0, 2, 4, 6): the knots in frames 4 and 6 are one run, begun in a crossing.
+  gdsr::ValidityOptions opt;
+  opt.intersection_stride = 2;
+  const gdsr::ValidityFigures s2 = gdsr::measure_validity(d, opt);
+  CHECK(s2.hr.si_knots == 1);
+  CHECK(s2.hr.si_knots_from_body_crossings == 1);
+  CHECK(s2.hr.si_knot_frames_from_body_crossings == 2);
+  // Without the body: knots counted, their share not measured.
+  opt.intersection_stride = 1;
+  opt.body = false;
+  const gdsr::ValidityFigures nb = gdsr::measure_validity(d, opt);
+  CHECK(nb.hr.si_knots == 3);
+  CHECK(nb.hr.si_knots_from_body_crossings == -1);
+  CHECK(gdsr::validity_table(nb).find("begun where the body crosses itself") == std::string::npos);
+  // Survives the manifest and is printed; manifests without the keys read -1 ("not measured").
+  const nlohmann::json j = gdsr::validity_to_json(v);
+  const gdsr::ValidityFigures back = gdsr::validity_from_json(j);
+  CHECK(back.hr.si_knots == 3);
+  CHECK(back.hr.si_knots_from_body_crossings == 1);
+  CHECK(back.hr.si_knot_frames_from_body_crossings == 2);
+  const std::string table = gdsr::validity_table(v);
+  CHECK(table.find("self-intersection: knots (runs of frames)              0              3") != std::string::npos);
+  CHECK(table.find("begun where the body crosses itself") != std::string::npos);
+  CHECK(table.find("1 (2 fr)") != std::string::npos);
+  nlohmann::json old = j;
+  for (const char* key : {"knots", "knots_from_body_crossings", "knot_frames_from_body_crossings"})
+    for (const char* res : {"lr", "hr"}) old[res]["self_intersection"].erase(key);
+  const gdsr::ValidityFigures o = gdsr::validity_from_json(old);
+  CHECK(o.hr.si_knots == -1);
+  CHECK(o.hr.si_knots_from_body_crossings == -1);
+  CHECK(gdsr::validity_table(o).find("knots") == std::string::npos);
+}
+
 TEST_CASE("gdsr: validity counts the HR frames that overlap themselves, on every k-th frame") {
   gdsr::Dataset d = gdsr_test::wave_dataset(4);
   // Frame 2: the HR sheet wrapped 1.25 times round a cylinder, so a quarter lies on itself.

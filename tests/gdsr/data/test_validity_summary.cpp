@@ -67,6 +67,10 @@ TEST_CASE("validity summary: a Markdown row per dataset with its figures and wha
   gdsr::ValiditySummaryRow ok{"clip_a", "skirt_short", passing(), 0.05, 0.5};
   gdsr::ValiditySummaryRow bad{"clip_b", "tshirt", passing(), 0.1, 1.2};
   bad.v.hr.si_clean_frames = 5;
+  bad.v.hr.si_knots = 2;  // runs of frames through itself, one of them begun where the body crosses itself
+  bad.v.hr.si_knots_from_body_crossings = 1;
+  bad.v.lr.si_knots = bad.v.lr.si_knots_from_body_crossings = 0;
+  bad.v.body_crossing_frames = 4;
   bad.v.agreement_mean = 0.0305;
   // The stretched-fibre part of the strain, HR over LR (the rest of E_u and E_v is compression).
   ok.v.lr.strain.E_u_stretched = 0.0004, ok.v.hr.strain.E_u_stretched = 0.0003;
@@ -81,6 +85,7 @@ TEST_CASE("validity summary: a Markdown row per dataset with its figures and wha
   CHECK(md.find("| 0.0080 / 0.0080 | 0.75x, 1.20x | 0 / 0 (0 / 3 vertices) |") != std::string::npos);
   CHECK(md.find("| 0.0080 / 0.0080 | -, - | 0 / 0 |") != std::string::npos);
   CHECK(md.find("| 15.0 (0.0 / 0.0) | 1.11x | 0.05 / 0.50 | pass |") != std::string::npos);
-  CHECK(md.find("| clip_b | tshirt | 10 | 100.0 / 50.0% |") != std::string::npos);
+  CHECK(md.find("| clip_b | tshirt | 10 | 100.0 / 50.0% (knots 0 / 2, 0 / 1 from body crossings) |") !=
+        std::string::npos);
   CHECK(md.find("| 30.5 (0.0 / 0.0) | 1.11x | 0.10 / 1.20 | clean, agreement |\n") != std::string::npos);
 }
