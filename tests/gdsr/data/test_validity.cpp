@@ -13,6 +13,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -321,33 +322,28 @@ TEST_CASE("gdsr: validity counts knots, runs of frames through itself, and those
   for (int t : {1, 3, 4, 6}) d.hr_frames[t] = wrapped;
   const gdsr::ValidityFigures v = gdsr::measure_validity(d);
   REQUIRE(v.body_crossing_frames == 2);
+  // (knots, those begun where the body crosses itself, their frames) of one resolution
+  auto knots = [](const gdsr::ResolutionValidity& r) {
+    return std::array<int, 3>{r.si_knots, r.si_knots_from_body_crossings, r.si_knot_frames_from_body_crossings};
+  };
   CHECK(v.hr.si_clean_frames == 3);
-  CHECK(v.hr.si_knots == 3);
-  CHECK(v.hr.si_knots_from_body_crossings == 1);
-  CHECK(v.hr.si_knot_frames_from_body_crossings == 2);
-  CHECK(v.lr.si_knots == 0);
-  CHECK(v.lr.si_knots_from_body_crossings == 0);
-  CHECK(v.lr.si_knot_frames_from_body_crossings == 0);
+  CHECK(knots(v.hr) == std::array<int, 3>{3, 1, 2});
+  CHECK(knots(v.lr) == std::array<int, 3>{0, 0, 0});
   // Every 2nd frame (0, 2, 4, 6): the knots in frames 4 and 6 are one run, begun in a crossing.
   gdsr::ValidityOptions opt;
   opt.intersection_stride = 2;
   const gdsr::ValidityFigures s2 = gdsr::measure_validity(d, opt);
-  CHECK(s2.hr.si_knots == 1);
-  CHECK(s2.hr.si_knots_from_body_crossings == 1);
-  CHECK(s2.hr.si_knot_frames_from_body_crossings == 2);
+  CHECK(knots(s2.hr) == std::array<int, 3>{1, 1, 2});
   // Without the body: knots counted, their share not measured.
   opt.intersection_stride = 1;
   opt.body = false;
   const gdsr::ValidityFigures nb = gdsr::measure_validity(d, opt);
-  CHECK(nb.hr.si_knots == 3);
-  CHECK(nb.hr.si_knots_from_body_crossings == -1);
+  CHECK(knots(nb.hr) == std::array<int, 3>{3, -1, -1});
   CHECK(gdsr::validity_table(nb).find("begun where the body crosses itself") == std::string::npos);
   // Survives the manifest and is printed; manifests without the keys read -1 ("not measured").
   const nlohmann::json j = gdsr::validity_to_json(v);
   const gdsr::ValidityFigures back = gdsr::validity_from_json(j);
-  CHECK(back.hr.si_knots == 3);
-  CHECK(back.hr.si_knots_from_body_crossings == 1);
-  CHECK(back.hr.si_knot_frames_from_body_crossings == 2);
+  CHECK(knots(back.hr) == std::array<int, 3>{3, 1, 2});
   const std::string table = gdsr::validity_table(v);
   CHECK(table.find("self-intersection: knots (runs of frames)              0              3") != std::string::npos);
   CHECK(table.find("begun where the body crosses itself") != std::string::npos);
@@ -356,8 +352,7 @@ TEST_CASE("gdsr: validity counts knots, runs of frames through itself, and those
   for (const char* key : {"knots", "knots_from_body_crossings", "knot_frames_from_body_crossings"})
     for (const char* res : {"lr", "hr"}) old[res]["self_intersection"].erase(key);
   const gdsr::ValidityFigures o = gdsr::validity_from_json(old);
-  CHECK(o.hr.si_knots == -1);
-  CHECK(o.hr.si_knots_from_body_crossings == -1);
+  CHECK(knots(o.hr) == std::array<int, 3>{-1, -1, -1});
   CHECK(gdsr::validity_table(o).find("knots") == std::string::npos);
 }
 
