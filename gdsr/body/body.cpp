@@ -600,8 +600,11 @@ struct ArmTurn {
 // the arm's deepest point along the body's normal there. No turn when it is clear already.
 // Some poses no turn clears: in the lunge of CMU 131_01 from 2 s (frames 44-53), trunk bent forward,
 // the left forearm lies up to 59 mm deep in the lower back, and no turn up to 60 degrees clears it,
-// about this axis, the upper arm's own axis or the axis across both, either way (tried 2026-12-06).
-// The tiered skirt's waistband knots there (`gdsr data preview --intersections --layer 1`).
+// about this axis, the upper arm's own axis or the axis across both, either way; nor does a turn
+// of the forearm at the elbow (tried 2026-12-06): the deepest point is the elbow, 0.29 m below the
+// shoulder, with the back bent over it. The tiered skirt's waistband knots there (`gdsr data
+// preview --intersections --layer 1`; the validity figures count it as a knot begun where the body
+// crosses itself).
 ArmTurn arm_turn(const Rig& rig, const Skin& sk, const ToMetres& to_out, const ArmParts& parts, int a,
                  const std::vector<Trs>& L, const BodyOptions& opt) {
   auto gap = [&](const std::vector<Trs>& pose) { return arm_gap(to_out(sk.apply(rig.globals(pose))), parts, a); };
