@@ -631,8 +631,9 @@ void run_preview(const PreviewArgs& a) {
     if (a.penetration) {
       const InBody in = mark_penetration(d, t, g, 1e-3 * a.pinch_gap_mm, mark);
       note += ", " + std::to_string(in.faces) + " in body (" + std::to_string(in.pinched) + " pinched)";
-      std::printf("%s: %d faces with a corner > %g mm in the body outside pinches (deepest %.1f mm), %d pinched\n",
-                  name, in.faces, 1000 * gdsr::ValidityOptions{}.penetration_limit, 1000 * in.deepest, in.pinched);
+      std::printf("%s: %d faces%s with a corner > %g mm in the body outside pinches (deepest %.1f mm), %d pinched\n",
+                  name, in.faces, a.layer >= 0 ? (" on layer " + std::to_string(a.layer)).c_str() : "",
+                  1000 * gdsr::ValidityOptions{}.penetration_limit, 1000 * in.deepest, in.pinched);
     }
     // BGR: cloth, pinched cyan, in the body magenta, intersecting red.
     const std::array<cv::Vec3b, kMarks> colour = {c, cv::Vec3b(230, 200, 0), cv::Vec3b(200, 40, 200),

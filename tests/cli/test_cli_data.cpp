@@ -349,7 +349,21 @@ TEST_CASE("cli data: preview draws the faces of a knot hidden under an outer lay
       gdsr_run(dir, "data preview --data '" + (dir / "ds") + "' --layer 3 --out '" + (dir / "bad.png") + "'"),
       "has 3 layers: 0-2");
   CHECK_FALSE(fs::exists(dir / "bad.png"));
-  // A one-layer dataset has layer 0 only.
+  // A one-layer dataset has layer 0 only: with --layer 0 its penetration count is the whole
+  // garment's, and says which layer it is of.
+  gdsr::write_dataset(dir / "box", gdsr_test::stretched_dataset({0.001, 0.008}));
+  auto in_body = [&](const std::string& flags) {
+    const std::string out = gdsr_run(dir, "data preview --data '" + (dir / "box") + "' --frame 1 --penetration " +
+                                              flags + " --size 64 --out '" + (dir / "b.png") + "'")
+                                .out;
+    const size_t at = out.find("LR: ");
+    REQUIRE(at != std::string::npos);
+    return out.substr(at, out.find(" with a corner", at) - at);
+  };
+  const std::string whole = in_body(""), layer0 = in_body("--layer 0");
+  CHECK(whole.find(" faces") != std::string::npos);
+  CHECK(whole != "LR: 0 faces");
+  CHECK(layer0 == whole + " on layer 0");
   gdsr::write_dataset(dir / "wave", gdsr_test::wave_dataset(2));
   CHECK(
       gdsr_run(dir, "data preview --data '" + (dir / "wave") + "' --layer 0 --size 64 --out '" + (dir / "w.png") + "'")
