@@ -5,6 +5,7 @@
 
 #include "gdsr/body/body.hpp"
 #include "gdsr/geometry/correspondence.hpp"
+#include "gdsr/geometry/mesh_ops.hpp"
 #include "gdsr/geometry/obj_io.hpp"
 #include "gdsr/data/dataset.hpp"
 #include "gdsr/data/md_import.hpp"
@@ -569,18 +570,20 @@ void draw_through(const gdsr::TriMesh& g, std::vector<int> mark, const std::arra
   blend.copyTo(img, ~empty);
 }
 
-// The faces of g (and their marks) whose first corner lies on cloth layer `layer` of `layers`
-// (per vertex; empty: one layer, 0).
+// The faces of g (and their marks) on cloth layer `layer` (gdsr::faces_by_layer: the layer of
+// a face's first corner; `layers` per vertex, empty: one layer, 0).
 void keep_layer(int layer, const std::vector<int>& layers, gdsr::TriMesh& g, std::vector<int>& mark) {
-  int n = 0;
-  for (int f = 0; f < g.F.rows(); ++f) {
-    const int l = layers.empty() ? 0 : layers[g.F(f, 0)];
-    if (l != layer) continue;
-    g.F.row(n) = g.F.row(f);
-    mark[n++] = mark[f];
+  const std::vector<std::vector<int>> by_layer = gdsr::faces_by_layer(layers, g.F);
+  const std::vector<int> none;
+  const std::vector<int>& kept = layer < static_cast<int>(by_layer.size()) ? by_layer[layer] : none;
+  gdsr::Faces F(static_cast<Eigen::Index>(kept.size()), 3);
+  std::vector<int> m(kept.size());
+  for (size_t i = 0; i < kept.size(); ++i) {
+    F.row(static_cast<Eigen::Index>(i)) = g.F.row(kept[i]);
+    m[i] = mark[kept[i]];
   }
-  g.F.conservativeResize(n, 3);
-  mark.resize(n);
+  g.F = std::move(F);
+  mark = std::move(m);
 }
 
 void run_preview(const PreviewArgs& a) {

@@ -388,22 +388,20 @@ nlohmann::json resolution_json(const ResolutionValidity& r, bool body) {
                         {"torn_frames", r.torn_frames},
                         {"torn_vertices", r.torn_vertices}}},
                       {"mean_curvature_1_m", r.mean_curvature}};
-  if (body) {
-    j["self_intersection"]["knots_from_body_crossings"] = r.si_knots_from_body_crossings;
-    j["self_intersection"]["knot_frames_from_body_crossings"] = r.si_knot_frames_from_body_crossings;
-  }
-  if (body)
-    j["body"] = {{"max_penetration_m", r.max_penetration},
-                 {"max_penetration_frame", r.max_penetration_frame},
-                 {"frames_over_limit", r.frames_over_limit},
-                 {"max_penetration_outside_pinches_m", r.max_penetration_free},
-                 {"max_penetration_outside_pinches_frame", r.max_penetration_free_frame},
-                 {"frames_over_limit_outside_pinches", r.frames_over_limit_free},
-                 {"pinch_frames", r.pinch_frames},
-                 {"pinch_frames_in_body_crossings", r.pinch_frames_in_body_crossings},
-                 {"threaded_frames", r.threaded_frames},
-                 {"max_threaded_edges", r.max_threaded_edges},
-                 {"max_threaded_frame", r.max_threaded_frame}};
+  if (!body) return j;
+  j["self_intersection"]["knots_from_body_crossings"] = r.si_knots_from_body_crossings;
+  j["self_intersection"]["knot_frames_from_body_crossings"] = r.si_knot_frames_from_body_crossings;
+  j["body"] = {{"max_penetration_m", r.max_penetration},
+               {"max_penetration_frame", r.max_penetration_frame},
+               {"frames_over_limit", r.frames_over_limit},
+               {"max_penetration_outside_pinches_m", r.max_penetration_free},
+               {"max_penetration_outside_pinches_frame", r.max_penetration_free_frame},
+               {"frames_over_limit_outside_pinches", r.frames_over_limit_free},
+               {"pinch_frames", r.pinch_frames},
+               {"pinch_frames_in_body_crossings", r.pinch_frames_in_body_crossings},
+               {"threaded_frames", r.threaded_frames},
+               {"max_threaded_edges", r.max_threaded_edges},
+               {"max_threaded_frame", r.max_threaded_frame}};
   return j;
 }
 
