@@ -74,6 +74,7 @@ struct MakeArgs {
          dressed_radius = NAN;
   double contact_travel = NAN;
   double arm_clearance = 0.01;  // metres, gdsr::BodyOptions::arm_clearance (0: the motion as in the file)
+  double min_shoulder_half_width = gdsr::BodyOptions{}.min_shoulder_half_width;  // metres (0: as in the file)
   double pin_yield_rate = NAN;
   double track_rate = NAN;  // 1/s: the HR simulation follows the LR one at the LR scale (sim/cloth_tracking.hpp)
   bool self_collision = true;
@@ -186,6 +187,7 @@ void run_make(const MakeArgs& a) {
   bo.max_seconds = a.seconds;
   bo.rest_arm_drop_degrees = sim::rest_arm_drop_degrees(a.garment);
   bo.arm_clearance = a.arm_clearance;
+  bo.min_shoulder_half_width = a.min_shoulder_half_width;
   const double t_body = now_seconds();
   const gdsr::BodySequence body = gdsr::load_body_sequence(a.motion, bo);
   std::printf("body: %s, %d frames at %g fps (%d rest blend), %ld vertices, %.1f s\n", a.motion.c_str(),
@@ -194,6 +196,11 @@ void run_make(const MakeArgs& a) {
   if (bo.rest_arm_drop_degrees >= 0)
     std::printf("body: rest pose with the upper arms %g degrees below level (the %s is cut for it)\n",
                 bo.rest_arm_drop_degrees, a.garment.c_str());
+  if (body.shoulders_widened)
+    std::printf(
+        "body: shoulder joints %.3f m from the middle in the file, moved out to %.3f m "
+        "(--min-shoulder-half-width)\n",
+        body.captured_shoulder_half_width, bo.min_shoulder_half_width);
   if (body.arm_turns.turned_frames() > 0)
     std::printf(
         "body: an arm came within %g mm of the trunk or legs in %d frames; turned out at the shoulder by "
@@ -285,6 +292,9 @@ void run_make(const MakeArgs& a) {
                   {"hr_start", hr_start_name(a)},
                   {"rest_arm_drop_degrees", bo.rest_arm_drop_degrees},
                   {"arm_clearance_m", bo.arm_clearance},
+                  {"min_shoulder_half_width_m", bo.min_shoulder_half_width},
+                  {"captured_shoulder_half_width_m", body.captured_shoulder_half_width},
+                  {"shoulders_widened", body.shoulders_widened},
                   {"arm_turned_frames", body.arm_turns.turned_frames()},
                   {"arm_turn_max_degrees", body.arm_turns.max_degrees()},
                   {"arm_still_inside_frames", body.arm_turns.still_inside_frames},
@@ -372,6 +382,13 @@ bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why
     }
     if (!same(sp.value("arm_clearance_m", 0.0), a.arm_clearance)) {
       why = "built with another arm clearance";
+      return false;
+    }
+    // Another limit changes nothing when the file's shoulders are wider than both.
+    const double built_limit = sp.value("min_shoulder_half_width_m", 0.0);
+    if (!same(built_limit, a.min_shoulder_half_width) &&
+        !(sp.value("captured_shoulder_half_width_m", 0.0) >= std::max(built_limit, a.min_shoulder_half_width))) {
+      why = "built with another shoulder width limit";
       return false;
     }
     if (sp.value("contact_every", 0) != effective_contact_every(a)) {
@@ -908,6 +925,11 @@ void add_data_command(CLI::App& app) {
                    "the file")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.1));
+  make->add_option("--min-shoulder-half-width", mk->min_shoulder_half_width,
+                   "metres: a skeleton whose shoulder joints are closer than this to the middle has them moved "
+                   "out to it (the CMU salsa BVHs' 0.126 m hang the arms inside the trunk); 0: as in the file")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.3));
   make->add_option("--rest-blend", mk->rest_blend_frames, "frames blending from the rest pose")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));

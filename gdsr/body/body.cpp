@@ -72,14 +72,16 @@ template <class Key> double frac(const Key* keys, unsigned n, int i, double tick
   return dt > 0 ? std::clamp((tick - keys[i].mTime) / dt, 0.0, 1.0) : 0.0;
 }
 
-Trs sample(const aiNodeAnim* ch, double tick, const Trs& rest) {
+// The channel's keys at `tick`; parts without keys keep `rest`'s. `moved` is added to the
+// position keys (a joint moved in its parent's frame, already in `rest`).
+Trs sample(const aiNodeAnim* ch, double tick, const Trs& rest, const Vec3& moved) {
   Trs r = rest;
   if (ch->mNumPositionKeys > 0) {
     const int i = bracket(ch->mPositionKeys, ch->mNumPositionKeys, tick);
     const double a = frac(ch->mPositionKeys, ch->mNumPositionKeys, i, tick);
     const auto& k0 = ch->mPositionKeys[i].mValue;
     const auto& k1 = ch->mPositionKeys[std::min<int>(i + 1, ch->mNumPositionKeys - 1)].mValue;
-    r.t = (1 - a) * Vec3(k0.x, k0.y, k0.z) + a * Vec3(k1.x, k1.y, k1.z);
+    r.t = (1 - a) * Vec3(k0.x, k0.y, k0.z) + a * Vec3(k1.x, k1.y, k1.z) + moved;
   }
   if (ch->mNumRotationKeys > 0) {
     const int i = bracket(ch->mRotationKeys, ch->mNumRotationKeys, tick);
@@ -105,6 +107,7 @@ struct Rig {
   std::vector<int> parent;
   std::vector<Trs> rest;
   std::vector<const aiNodeAnim*> channel;
+  std::vector<Vec3> moved;  // per node: offset added to its translation in every pose (file units)
   std::map<std::string, int> index;
   Mat4 pre = Mat4::Identity();  // up-axis fix applied above the root
 
@@ -160,6 +163,7 @@ void collect(const aiNode* n, int parent, Rig& rig) {
   rig.parent.push_back(parent);
   rig.rest.push_back(decompose(n->mTransformation));
   rig.channel.push_back(nullptr);
+  rig.moved.push_back(Vec3::Zero());
   rig.index[n->mName.C_Str()] = id;
   for (unsigned c = 0; c < n->mNumChildren; ++c) collect(n->mChildren[c], id, rig);
 }
@@ -309,7 +313,7 @@ Clip read_clip(const aiScene* s, const std::string& path, const BodyOptions& opt
 std::vector<Trs> pose_at(const Clip& c, double seconds) {
   std::vector<Trs> L(c.rig.rest);
   for (size_t i = 0; i < c.rig.node.size(); ++i)
-    if (c.rig.channel[i]) L[i] = sample(c.rig.channel[i], (c.t0 + seconds) * c.tps, c.rig.rest[i]);
+    if (c.rig.channel[i]) L[i] = sample(c.rig.channel[i], (c.t0 + seconds) * c.tps, c.rig.rest[i], c.rig.moved[i]);
   return L;
 }
 
@@ -383,6 +387,49 @@ void raise_hanging_arms(Rig& rig, const std::string& path) {
   turn_upper_arms(rig, rig.rest, path, 0, [](const Vec3& arm) { return arm.y() <= -std::sin(60 * M_PI / 180); });
 }
 
+// Metres per file unit of a skeleton body `height` tall (joint extent at its rest pose; the
+// head and feet add 4%).
+double skeleton_metres_per_unit(const std::vector<detail::SkelNode>& nodes, double height, const std::string& path) {
+  double ymin = 1e300, ymax = -1e300;
+  for (const auto& n : nodes) ymin = std::min(ymin, n.pos.y()), ymax = std::max(ymax, n.pos.y());
+  if (!(ymax - ymin > 0)) gdsr::fail("load_body_sequence: " + path, "skeleton has zero height at the rest pose");
+  return height / ((ymax - ymin) * 1.04);
+}
+
+// BodyOptions::min_shoulder_half_width. Returns the shoulder joints' distance from the middle as
+// captured, metres (0: no two upper arms); `widened` says whether they were moved.
+// Measured on 2026-12-07 over the salsa part of the 30 mm matrix (six garments on 60_02 and 61_03,
+// 4 s from 2 s, frictions 0.3 and 0.30001: 24 runs), joints as filed -> moved out to 0.20 m:
+// frames where the body crosses itself 2536 -> 780; runs free of self-intersections at both
+// resolutions 21 -> 22 (worst 86.0% -> 94.9%); runs over the strain limits 5 -> 2; frames with
+// cloth > 5 mm in the body outside pinches, LR / 2nd run, 36 / 30 -> 40 / 44, of which the
+// t-shirt on 61_03 5 / 2 -> 24 / 25 (its cuff slides over the hand held forward, frames 57-67).
+double widen_narrow_shoulders(Rig& rig, const BodyOptions& opt, const std::string& path, bool& widened) {
+  widened = false;
+  const std::vector<Mat4> G = rig.globals(rig.rest);
+  const SkeletonNodes sn = skeleton_nodes(rig, G, path);
+  const std::vector<int> arms = detail::upper_arm_starts(sn.nodes);
+  if (arms.size() != 2 || sn.nodes.size() < 3) return 0;
+  const double mpu = skeleton_metres_per_unit(sn.nodes, opt.height, path);
+  const Vec3 mid = 0.5 * (sn.nodes[arms[0]].pos + sn.nodes[arms[1]].pos);
+  Vec3 across = sn.nodes[arms[0]].pos - mid;
+  across.y() = 0;
+  const double half = across.norm() * mpu;
+  if (!(half < opt.min_shoulder_half_width) || half < 1e-6) return half;
+  for (int a : arms) {
+    Vec3 out = sn.nodes[a].pos - mid;
+    out.y() = 0;
+    const int r = sn.to_rig[a], par = rig.parent[r];
+    const Mat4& Gp = par >= 0 ? G[par] : rig.pre;
+    const Vec3 local =
+        Gp.topLeftCorner<3, 3>().inverse() * (out.normalized() * (opt.min_shoulder_half_width - half) / mpu);
+    rig.rest[r].t += local;
+    rig.moved[r] += local;
+  }
+  widened = true;
+  return half;
+}
+
 // The body surface with its skin: the file's skinned meshes, or a body built around the
 // skeleton (sb, and shape_to_rest: the skeleton body's landmark space -> rest pose).
 struct Surface {
@@ -408,10 +455,7 @@ Surface build_surface(const aiScene* s, const Clip& c, const std::vector<Mat4>& 
   const std::vector<int>& to_rig = sn.to_rig;
   out.shape_to_rest = G_rest[to_rig[0]] * G_shape[to_rig[0]].inverse();
   if (nodes.size() < 3) gdsr::fail("load_body_sequence: " + path, "skeleton has fewer than 3 joints");
-  double ymin = 1e300, ymax = -1e300;
-  for (const auto& n : nodes) ymin = std::min(ymin, n.pos.y()), ymax = std::max(ymax, n.pos.y());
-  if (!(ymax - ymin > 0)) gdsr::fail("load_body_sequence: " + path, "skeleton has zero height at the rest pose");
-  const double mpu = opt.height / ((ymax - ymin) * 1.04);
+  const double mpu = skeleton_metres_per_unit(nodes, opt.height, path);
   out.sb = detail::build_skeleton_body(nodes, mpu, opt.body_edge);
   // Skin matrices: node k -> G(t) * G_rest^-1, bind space = rest world.
   Skin& sk = out.sk;
@@ -719,11 +763,12 @@ BodyLandmarks measure_landmarks(const TriMesh& rest, const Surface& surf, const 
 BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_only) {
   if (!(opt.fps > 0) || !(opt.height > 0) || opt.rest_blend_frames < 0 || !(opt.start_seconds >= 0) ||
       !(opt.body_edge > 0) || !(opt.rest_arm_drop_degrees <= 80) || !(opt.arm_clearance >= 0) ||
-      !(opt.max_arm_turn_degrees > 0 && opt.max_arm_turn_degrees <= 90) || !(opt.arm_turn_ease_seconds >= 0))
+      !(opt.max_arm_turn_degrees > 0 && opt.max_arm_turn_degrees <= 90) || !(opt.arm_turn_ease_seconds >= 0) ||
+      !(opt.min_shoulder_half_width >= 0 && opt.min_shoulder_half_width < 0.5))
     gdsr::fail("load_body_sequence: " + path,
                "bad BodyOptions (fps, height, body_edge must be > 0, rest_blend_frames and start_seconds >= 0, "
                "rest_arm_drop_degrees <= 80, arm_clearance >= 0, max_arm_turn_degrees in (0, 90], "
-               "arm_turn_ease_seconds >= 0)");
+               "arm_turn_ease_seconds >= 0, min_shoulder_half_width in [0, 0.5) m)");
   if (!std::ifstream(path).good()) gdsr::fail("load_body_sequence: " + path, "file not found or not readable");
   Assimp::Importer imp;
   const aiScene* s =
@@ -732,7 +777,12 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
     gdsr::fail("load_body_sequence: " + path, std::string("assimp cannot read it: ") + imp.GetErrorString());
 
   Clip clip = read_clip(s, path, opt);
-  if (!clip.skinned) raise_hanging_arms(clip.rig, path);
+  double captured_shoulder_half_width = 0;
+  bool shoulders_widened = false;
+  if (!clip.skinned) {
+    raise_hanging_arms(clip.rig, path);
+    captured_shoulder_half_width = widen_narrow_shoulders(clip.rig, opt, path, shoulders_widened);
+  }
   if (opt.start_seconds > clip.duration)
     gdsr::fail("load_body_sequence: " + path,
                "start_seconds beyond the clip length " + std::to_string(clip.duration) + " s");
@@ -758,6 +808,8 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
   seq.source = path;
   seq.from_skeleton = !clip.skinned;
   seq.torso_found = clip.skinned || surf.sb.torso_found;
+  seq.captured_shoulder_half_width = captured_shoulder_half_width;
+  seq.shoulders_widened = shoulders_widened;
   // Frame 0, where garments are put on: the file's rest pose, or its A-pose (placed, scaled
   // and meshed as the file's rest pose, so every later frame is the same either way).
   std::vector<Trs> start_local = rest_local;

@@ -60,6 +60,12 @@ struct BodyOptions {
   double arm_clearance = 0;
   double max_arm_turn_degrees = 30;
   double arm_turn_ease_seconds = 0.2;
+  // Skeleton bodies only: shoulder joints closer than this many metres to the middle (at the
+  // rest pose, on a body `height` tall) are moved out, level, to it, in their parent's frame, so
+  // the collar carries them through the motion. The trunk is built to an anatomical width, and
+  // narrower shoulders hang the arms inside it (the CMU salsa BVHs: 0.126 m; CMU 01: 0.213 m,
+  // CMU 131: 0.204 m). 0: the joints where the file has them.
+  double min_shoulder_half_width = 0.20;
 };
 
 // How BodyOptions::arm_clearance changed the motion.
@@ -113,6 +119,10 @@ struct BodySequence {
   // of capsules; `gdsr data make` warns). Always true for skinned meshes.
   bool torso_found = true;
   ArmTurns arm_turns;  // empty degrees unless BodyOptions::arm_clearance > 0
+  // Skeleton bodies with two upper arms: the shoulder joints' distance from the middle as in
+  // the file, metres (0: not measured), and whether BodyOptions::min_shoulder_half_width moved them.
+  double captured_shoulder_half_width = 0;
+  bool shoulders_widened = false;
 
   int num_frames() const { return static_cast<int>(frames.size()); }
   TriMesh frame_mesh(int t) const;  // throws on t out of range

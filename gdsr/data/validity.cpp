@@ -148,20 +148,6 @@ Depths penetration(const BodyQuery& body, const ClosestPoints& cp, const Points3
   return d;
 }
 
-// Two body faces intersect (CGAL) whose vertices were all farther than sep apart in the first
-// frame, rest: two parts, one inside the other (validity.hpp).
-bool body_crosses_itself(const Points3& V, const Faces& F, const Points3& rest, double sep) {
-  const SelfIntersections si = self_intersections(V, F, /*list_pairs=*/true);
-  const double sep2 = sep * sep;
-  for (const auto& [f, g] : si.list) {
-    bool apart = true;
-    for (int a = 0; a < 3 && apart; ++a)
-      for (int b = 0; b < 3 && apart; ++b) apart = (rest.row(F(f, a)) - rest.row(F(g, b))).squaredNorm() > sep2;
-    if (apart) return true;
-  }
-  return false;
-}
-
 // Edges of X (rows of `edges`) with both ends outside the body whose segment runs through it:
 // the middle of its span between the first and the last crossing lies deeper than `depth`
 // metres (validity.hpp; a chord grazing a curved surface dips in by a fraction of that).
@@ -225,6 +211,20 @@ double mean_distance(const Points3& a, const Points3& b) {
 }
 
 }  // namespace
+
+// Two body faces intersect (CGAL) whose vertices were all farther than sep apart in the first
+// frame, rest: two parts, one inside the other (validity.hpp).
+bool body_crosses_itself(const Points3& V, const Faces& F, const Points3& rest, double sep) {
+  const SelfIntersections si = self_intersections(V, F, /*list_pairs=*/true);
+  const double sep2 = sep * sep;
+  for (const auto& [f, g] : si.list) {
+    bool apart = true;
+    for (int a = 0; a < 3 && apart; ++a)
+      for (int b = 0; b < 3 && apart; ++b) apart = (rest.row(F(f, a)) - rest.row(F(g, b))).squaredNorm() > sep2;
+    if (apart) return true;
+  }
+  return false;
+}
 
 std::string validity_per_frame_csv(const ValidityFigures& v) {
   std::string s =

@@ -156,6 +156,11 @@ struct BodyDepths {
 };
 BodyDepths body_depths(const Dataset& d, int t, const Points3& X, const ValidityOptions& opt = {});
 
+// Whether two faces of a body mesh (V: one frame, N x 3, metres) intersect (CGAL) whose corners
+// were all farther than sep metres apart in `rest` (its first frame): one part inside another,
+// as counted by ValidityFigures::body_crossing_frames with sep = pinch_separation.
+bool body_crosses_itself(const Points3& V, const Faces& F, const Points3& rest, double sep);
+
 // The per-frame figures as CSV text: a header, then one line per frame (frame, LR and HR
 // intersecting pairs with -1 for unchecked frames, LR and HR depth outside pinches in mm,
 // agreement in mm, LR and HR threaded edges).

@@ -455,6 +455,38 @@ TEST_CASE("cli data: the t-shirt is simulated with its own body contact refresh,
   CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"contact_every\": 3") != std::string::npos);
 }
 
+TEST_CASE(
+    "cli data: a salsa skeleton's narrow shoulders are moved out, said, recorded, and rebuilt when the limit changes") {
+  // gdsr::BodyOptions::min_shoulder_half_width (tests/gdsr/body/test_body_shoulders.cpp measures the body).
+  TempDir dir("cli_shoulders");
+  const std::string out = dir / "ds";
+  const std::string cmd = "data make --skip-built --garment skirt_short --motion '" + std::string(GDSR_SHARED_DIR) +
+                          "/motions/cmu-salsa/61_03.bvh' --start 2 --out '" + out +
+                          "' --seconds 0.1 --lr-pd 0.08 --hr-pd 0.06 --rest-blend 2 --raster 64 --settle-frames 3";
+  const Run mk = gdsr_run(dir, cmd);
+  REQUIRE(mk.status == 0);
+  CHECK(mk.out.find("body: shoulder joints 0.126 m from the middle in the file, moved out to 0.200 m") !=
+        std::string::npos);
+  std::string manifest = gdsr_test::slurp(out + "/manifest.json");
+  CHECK(manifest.find("\"shoulders_widened\": true") != std::string::npos);
+  CHECK(manifest.find("\"min_shoulder_half_width_m\": 0.2") != std::string::npos);
+  CHECK(gdsr_run(dir, cmd).out.find("kept") != std::string::npos);
+  // A wider limit moves them again: rebuilt. A limit under the file's 0.126 m leaves them as the
+  // file has them, like 0: the second of those is kept.
+  const Run wider = gdsr_run(dir, cmd + " --min-shoulder-half-width 0.22");
+  REQUIRE(wider.status == 0);
+  CHECK(wider.out.find("built with another shoulder width limit") != std::string::npos);
+  CHECK(wider.out.find("moved out to 0.220 m") != std::string::npos);
+  const Run as_filed = gdsr_run(dir, cmd + " --min-shoulder-half-width 0");
+  REQUIRE(as_filed.status == 0);
+  CHECK(as_filed.out.find("built with another shoulder width limit") != std::string::npos);
+  CHECK(as_filed.out.find("body: shoulder joints") == std::string::npos);
+  manifest = gdsr_test::slurp(out + "/manifest.json");
+  CHECK(manifest.find("\"shoulders_widened\": false") != std::string::npos);
+  CHECK(gdsr_run(dir, cmd + " --min-shoulder-half-width 0.1").out.find("kept") != std::string::npos);
+  check_one_line_error(gdsr_run(dir, cmd + " --min-shoulder-half-width 0.5"), "--min-shoulder-half-width");
+}
+
 TEST_CASE("cli data: compare finds a repeat bit-identical, a nudged twin apart, and refuses other meshes") {
   TempDir dir("cli_compare");
   const std::string clip = " --garment skirt_short --seconds 0.2 --hr-pd 0.06 --rest-blend 2 --raster 64"

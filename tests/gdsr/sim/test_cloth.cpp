@@ -235,7 +235,9 @@ TEST_CASE("cloth: a hand sweeping past the pinned waistband lets the cloth slip 
   // On CMU salsa 61_02 a hand passing the pinned waistband carried single skirt vertices
   // 20+ cm out of the cloth: the contact, solved after the stretch, won every pass. With
   // contact_release_stretch (1.5) the contact gives way instead. Bound 2x: the stretch
-  // solve's own overshoot within a substep.
+  // solve's own overshoot within a substep. Without the release the hand drags edges past that
+  // bound: over 3x with the skeleton's shoulders as filed, 2.2x with them moved out
+  // (BodyOptions::min_shoulder_half_width), the hand passing farther from the waistband.
   const std::string bvh = std::string(GDSR_SHARED_DIR) + "/motions/cmu-salsa/61_02.bvh";
   REQUIRE_MESSAGE(std::ifstream(bvh).good(), bvh << " is missing (../shared beside the repository)");
   const double with = salsa_hand_sweep_stretch(bvh, 1.5);
@@ -243,7 +245,7 @@ TEST_CASE("cloth: a hand sweeping past the pinned waistband lets the cloth slip 
   CHECK(with < 2.0);
   const double without = salsa_hand_sweep_stretch(bvh, 1e9);  // the test can fail: without the release
   MESSAGE("largest edge stretch without release: " << without);
-  CHECK(without > 3.0);
+  CHECK(without > 2.0);
 }
 
 namespace {
