@@ -12,6 +12,7 @@
 #include "gdsr/data/recipe.hpp"
 #include "gdsr/data/validity.hpp"
 #include "gdsr/geometry/self_intersections.hpp"
+#include "gdsr/geometry/strain.hpp"
 #include "gdsr/cli/progress_bar.hpp"
 #include "gdsr/io/render.hpp"
 #include "gdsr/sim/cloth_solver.hpp"
@@ -716,8 +717,42 @@ struct CheckArgs {
   std::string per_frame;  // non-empty: write each frame's figures to this CSV
   int intersection_stride = kDefaultIntersectionStride;
   bool body = true;
+  bool strain_by_piece = false;  // also print the strain of each pattern piece
   double pinch_gap_mm = default_pinch_gap_mm();
 };
+
+// The strain of each piece of the pattern (UV island), averaged over the frames, for one
+// resolution: where a garment's mean E_u comes from (a sleeve compressed along the arm, say).
+void print_strain_by_piece(const char* res, const gdsr::GarmentMesh& g, const std::vector<gdsr::Points3>& frames) {
+  const std::vector<int> piece = gdsr::pattern_pieces(g);
+  const int n = piece.empty() ? 0 : 1 + *std::max_element(piece.begin(), piece.end());
+  std::vector<gdsr::StrainEnergies> sum(n);
+  for (const auto& X : frames) {
+    const auto e = gdsr::strain_energies_by_piece(g, X, piece);
+    for (int k = 0; k < n; ++k) {
+      sum[k].E_u += e[k].E_u, sum[k].E_v += e[k].E_v, sum[k].E_uv += e[k].E_uv;
+      sum[k].E_u_stretched += e[k].E_u_stretched, sum[k].E_v_stretched += e[k].E_v_stretched;
+      sum[k].faces = e[k].faces;
+    }
+  }
+  std::vector<double> x0(n, 1e300), x1(n, -1e300);
+  for (int f = 0; f < g.FUV.rows(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      x0[piece[f]] = std::min(x0[piece[f]], g.UV(g.FUV(f, c), 0));
+      x1[piece[f]] = std::max(x1[piece[f]], g.UV(g.FUV(f, c), 0));
+    }
+  double total_u = 0;
+  for (const auto& e : sum) total_u += e.E_u * e.faces;
+  const double T = std::max<size_t>(1, frames.size());
+  for (int k = 0; k < n; ++k) {
+    const auto& e = sum[k];
+    char range[64];
+    std::snprintf(range, sizeof range, "%.2f-%.2f", x0[k], x1[k]);
+    std::printf("  %-3s %5d %6d   %-11s %10.5f %10.5f %10.5f %10.5f %10.5f %8.1f%%\n", res, k, e.faces, range,
+                e.E_u / T, e.E_u_stretched / T, e.E_v / T, e.E_v_stretched / T, e.E_uv / T,
+                total_u > 0 ? 100.0 * e.E_u * e.faces / total_u : 0.0);
+  }
+}
 
 // "same" if every number of `a` equals the one at the same place in `b` (relative 1e-9),
 // else the path of the first difference.
@@ -763,6 +798,14 @@ void run_check(const CheckArgs& a) {
     const gdsr::ValidityFigures v = measure(d, vo, seconds);
     std::printf("%s", gdsr::validity_table(v).c_str());
     std::printf("  (validity figures: %.1f s)\n", seconds);
+    if (a.strain_by_piece) {
+      std::printf("strain by pattern piece (UV islands, numbered left to right in the pattern), means over %d frames\n",
+                  m.frames);
+      std::printf(
+          "  res piece  faces   UV x (m)           E_u  stretched        E_v  stretched       E_uv  share of E_u\n");
+      print_strain_by_piece("LR", d.lr, d.lr_frames);
+      print_strain_by_piece("HR", d.hr, d.hr_frames);
+    }
     if (!a.per_frame.empty()) {
       gdsr::write_text_atomic(a.per_frame, gdsr::validity_per_frame_csv(v));
       std::printf("  per-frame figures: %s\n", a.per_frame.c_str());
@@ -1006,6 +1049,8 @@ void add_data_command(CLI::App& app) {
   add_pinch_gap_option(ch, chk->pinch_gap_mm, "");
   ch->add_option("--per-frame", chk->per_frame,
                  "also write each frame's figures to this CSV (intersecting pairs, depth outside pinches, agreement)");
+  ch->add_flag("--strain-by-piece", chk->strain_by_piece,
+               "also print E_u, E_v and E_uv of each piece of the pattern (UV island), LR and HR, over the clip");
   ch->callback([chk]() { run_check(*chk); });
 
   add_data_compare_command(*data);

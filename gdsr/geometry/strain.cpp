@@ -1,6 +1,7 @@
 #include "gdsr/geometry/strain.hpp"
 
 #include "gdsr/error.hpp"
+#include "gdsr/geometry/union_find.hpp"
 
 #include <Eigen/Dense>
 
@@ -31,32 +32,78 @@ bool degenerate_uv(const GarmentMesh& g, int f, Eigen::Matrix2d& Dm) {
 
 }  // namespace
 
+namespace {
+
+// Adds face f's energies to s (sums, not yet means); false for a degenerate UV triangle.
+bool add_face(const GarmentMesh& g, const Points3& X, int f, StrainEnergies& s) {
+  Eigen::Matrix2d Dm;
+  if (degenerate_uv(g, f, Dm)) return false;
+  Eigen::Matrix<double, 3, 2> Ds;
+  Ds.col(0) = X.row(g.F(f, 1)) - X.row(g.F(f, 0));
+  Ds.col(1) = X.row(g.F(f, 2)) - X.row(g.F(f, 0));
+  const Eigen::Matrix<double, 3, 2> w = Ds * Dm.inverse();
+  const double lu = w.col(0).norm(), lv = w.col(1).norm(), d = w.col(0).dot(w.col(1));
+  s.E_u += (lu - 1) * (lu - 1);
+  s.E_v += (lv - 1) * (lv - 1);
+  s.E_uv += d * d;
+  s.E_u_stretched += lu > 1 ? (lu - 1) * (lu - 1) : 0.0;
+  s.E_v_stretched += lv > 1 ? (lv - 1) * (lv - 1) : 0.0;
+  ++s.faces;
+  return true;
+}
+
+void to_means(StrainEnergies& s) {
+  if (s.faces == 0) return;
+  for (double* e : {&s.E_u, &s.E_v, &s.E_uv, &s.E_u_stretched, &s.E_v_stretched}) *e /= s.faces;
+}
+
+}  // namespace
+
 StrainEnergies strain_energies(const GarmentMesh& g, const Points3& X) {
   check_positions(g, X);
   StrainEnergies s;
-  int n = 0;
+  for (int f = 0; f < g.F.rows(); ++f) add_face(g, X, f, s);
+  to_means(s);
+  return s;
+}
+
+std::vector<int> pattern_pieces(const GarmentMesh& g) {
+  const int nuv = static_cast<int>(g.UV.rows());
+  std::vector<int> parent(nuv);
+  for (int i = 0; i < nuv; ++i) parent[i] = i;
+  for (int f = 0; f < g.FUV.rows(); ++f)
+    for (int k = 1; k < 3; ++k) parent[find_root(parent, g.FUV(f, k))] = find_root(parent, g.FUV(f, 0));
+  // Each island's smallest UV x, then the islands in that order (ties: the lower root).
+  std::vector<double> min_x(nuv, std::numeric_limits<double>::infinity());
+  for (int f = 0; f < g.FUV.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int r = find_root(parent, g.FUV(f, k));
+      min_x[r] = std::min(min_x[r], g.UV(g.FUV(f, k), 0));
+    }
+  std::vector<int> roots;
+  for (int i = 0; i < nuv; ++i)
+    if (std::isfinite(min_x[i])) roots.push_back(i);
+  std::sort(roots.begin(), roots.end(),
+            [&](int a, int b) { return min_x[a] < min_x[b] || (min_x[a] == min_x[b] && a < b); });
+  std::vector<int> index(nuv, -1);
+  for (size_t k = 0; k < roots.size(); ++k) index[roots[k]] = static_cast<int>(k);
+  std::vector<int> piece(g.FUV.rows());
+  for (int f = 0; f < g.FUV.rows(); ++f) piece[f] = index[find_root(parent, g.FUV(f, 0))];
+  return piece;
+}
+
+std::vector<StrainEnergies> strain_energies_by_piece(const GarmentMesh& g, const Points3& X,
+                                                     const std::vector<int>& piece) {
+  check_positions(g, X);
+  if (piece.size() != static_cast<size_t>(g.F.rows()))
+    gdsr::fail("strain", std::to_string(piece.size()) + " piece indices for " + std::to_string(g.F.rows()) + " faces");
+  const int n = piece.empty() ? 0 : 1 + *std::max_element(piece.begin(), piece.end());
+  std::vector<StrainEnergies> s(n);
   for (int f = 0; f < g.F.rows(); ++f) {
-    Eigen::Matrix2d Dm;
-    if (degenerate_uv(g, f, Dm)) continue;
-    Eigen::Matrix<double, 3, 2> Ds;
-    Ds.col(0) = X.row(g.F(f, 1)) - X.row(g.F(f, 0));
-    Ds.col(1) = X.row(g.F(f, 2)) - X.row(g.F(f, 0));
-    const Eigen::Matrix<double, 3, 2> w = Ds * Dm.inverse();
-    const double lu = w.col(0).norm(), lv = w.col(1).norm(), d = w.col(0).dot(w.col(1));
-    s.E_u += (lu - 1) * (lu - 1);
-    s.E_v += (lv - 1) * (lv - 1);
-    s.E_uv += d * d;
-    s.E_u_stretched += lu > 1 ? (lu - 1) * (lu - 1) : 0.0;
-    s.E_v_stretched += lv > 1 ? (lv - 1) * (lv - 1) : 0.0;
-    ++n;
+    if (piece[f] < 0) gdsr::fail("strain", "negative piece index for face " + std::to_string(f));
+    add_face(g, X, f, s[piece[f]]);
   }
-  if (n > 0) {
-    s.E_u /= n;
-    s.E_v /= n;
-    s.E_uv /= n;
-    s.E_u_stretched /= n;
-    s.E_v_stretched /= n;
-  }
+  for (auto& e : s) to_means(e);
   return s;
 }
 

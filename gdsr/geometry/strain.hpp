@@ -18,12 +18,23 @@ struct StrainEnergies {
   double E_u = 0, E_v = 0, E_uv = 0;  // means over triangles (dimensionless)
   // The stretched part of E_u and E_v: means of max(|w_u| - 1, 0)^2, max(|w_v| - 1, 0)^2.
   double E_u_stretched = 0, E_v_stretched = 0;
+  int faces = 0;  // triangles averaged over (those with a non-degenerate UV triangle)
 };
 
 // X: positions of g's welded vertices (V x 3, metres), triangles g.F with UV triangles g.FUV.
 // Triangles whose UV area is degenerate (|det Dm| <= 1e-8 x longest UV edge^2, a scale-free
 // test) carry no deformation gradient and are left out of the means.
 StrainEnergies strain_energies(const GarmentMesh& g, const Points3& X);
+
+// The pieces of the flat pattern (its panels): per triangle, the index of its UV island (faces
+// joined through shared UV vertices), islands numbered by their smallest UV x, so in the order
+// the pattern lays its panels out from left to right.
+std::vector<int> pattern_pieces(const GarmentMesh& g);
+
+// strain_energies over each piece's triangles alone: element k for piece k of `piece`
+// (pattern_pieces(g)); a piece whose UV triangles are all degenerate gets zeros.
+std::vector<StrainEnergies> strain_energies_by_piece(const GarmentMesh& g, const Points3& X,
+                                                     const std::vector<int>& piece);
 
 // Longest edge of X over its length in the sewing pattern (dimensionless: 1 at rest, 2 for an
 // edge at twice its length). Woven fabric tears long before 2x, so a larger value marks cloth

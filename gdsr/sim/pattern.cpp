@@ -1,6 +1,7 @@
 #include "gdsr/sim/pattern.hpp"
 
 #include "gdsr/error.hpp"
+#include "gdsr/geometry/union_find.hpp"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Delaunay_mesh_face_base_2.h>
@@ -19,6 +20,7 @@
 
 namespace sim {
 
+using gdsr::find_root;
 using gdsr::Vec2;
 using gdsr::Vec3;
 
@@ -72,14 +74,6 @@ bool point_in_polygon(const Vec2& p, const std::vector<Vec2>& poly) {
       inside = !inside;
   }
   return inside;
-}
-
-int find_root(std::vector<int>& parent, int i) {
-  while (parent[i] != i) {
-    parent[i] = parent[parent[i]];
-    i = parent[i];
-  }
-  return i;
 }
 
 // Constrained Delaunay triangulation of the outline (pre-split boundary points `bpts`,

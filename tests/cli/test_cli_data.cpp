@@ -129,6 +129,31 @@ TEST_CASE("cli data: make a tiny dataset, check it and preview a frame") {
   CHECK(rows.rfind("frame,lr_pairs,hr_pairs,", 0) == 0);
   CHECK(std::count(rows.begin(), rows.end(), '\n') == 1 + gdsr::load_dataset(out).manifest.frames);
   CHECK_FALSE(fs::exists(csv + ".tmp"));
+  // The strain of each pattern piece: per resolution, the pieces' faces add up to the mesh's
+  // and their shares of E_u to 100%.
+  const Run byp = gdsr_run(dir, "data check --data '" + out + "' --strain-by-piece");
+  CHECK(byp.status == 0);
+  CHECK(byp.out.find("strain by pattern piece") != std::string::npos);
+  const gdsr::DatasetManifest mf = gdsr::load_dataset(out).manifest;
+  for (const std::string res : {"LR", "HR"}) {
+    std::istringstream lines(byp.out);
+    std::string line;
+    int pieces = 0, faces = 0;
+    double share = 0;
+    while (std::getline(lines, line)) {
+      std::istringstream row(line);
+      std::string r, xrange, pct;
+      int k = 0, nf = 0;
+      double eu = 0, eus = 0, ev = 0, evs = 0, euv = 0;
+      if (!(row >> r >> k >> nf >> xrange >> eu >> eus >> ev >> evs >> euv >> pct) || r != res) continue;
+      CHECK(k == pieces);
+      CHECK(eus <= eu + 1e-12);
+      ++pieces, faces += nf, share += std::stod(pct);
+    }
+    CHECK(pieces >= 2);  // skirt_short: front and back
+    CHECK(faces == (res == "LR" ? mf.lr_faces : mf.hr_faces));
+    CHECK(share == doctest::Approx(100).epsilon(0.01));
+  }
   const Run pv =
       gdsr_run(dir, "data preview --data '" + out + "' --frame 5 --size 128 --out '" + (dir / "p.png") + "'");
   CHECK(pv.status == 0);

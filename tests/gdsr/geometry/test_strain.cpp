@@ -83,3 +83,40 @@ TEST_CASE("strain: the longest edge over its pattern length finds one dragged-ou
   CHECK(std::isnan(gdsr::max_edge_stretch(g, d)));
   CHECK_THROWS_WITH(gdsr::max_edge_stretch(g, s.topRows(3)), doctest::Contains("3 positions"));
 }
+
+TEST_CASE("strain energies by pattern piece: UV islands left to right, each piece's own means") {
+  // Two unit squares welded along the edge x = 1 in 3-D, cut apart in the pattern: the right
+  // square's UV island lies at x 2..3, the left one's at 0..1. The faces list the right square
+  // first, so the numbering comes from the layout, not the face order.
+  gdsr::GarmentMesh g;
+  g.V.resize(6, 3);
+  g.V << 0, 0, 0, 1, 0, 0, 2, 0, 0, 0, 1, 0, 1, 1, 0, 2, 1, 0;
+  g.UV.resize(8, 2);
+  g.UV << 2, 0, 3, 0, 3, 1, 2, 1,  // right square: 3-D vertices 1, 2, 5, 4
+      0, 0, 1, 0, 1, 1, 0, 1;      // left square: 0, 1, 4, 3
+  g.uv_to_vertex = {1, 2, 5, 4, 0, 1, 4, 3};
+  g.F.resize(4, 3);
+  g.F << 1, 2, 5, 1, 5, 4, 0, 1, 4, 0, 4, 3;
+  g.FUV.resize(4, 3);
+  g.FUV << 0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7;
+  const std::vector<int> piece = gdsr::pattern_pieces(g);
+  CHECK(piece == std::vector<int>{1, 1, 0, 0});
+  // The right square shortened to 0.8 across, the left one left at rest: only piece 1 is
+  // strained, all of it in compression; the whole garment's mean is the face-weighted mean.
+  gdsr::Points3 X = g.V;
+  X(2, 0) = X(5, 0) = 1.8;
+  const auto by = gdsr::strain_energies_by_piece(g, X, piece);
+  REQUIRE(by.size() == 2);
+  CHECK(by[0].faces == 2);
+  CHECK(by[0].E_u == doctest::Approx(0).epsilon(1e-12));
+  CHECK(by[1].faces == 2);
+  CHECK(by[1].E_u == doctest::Approx(0.04));
+  CHECK(by[1].E_u_stretched == doctest::Approx(0).epsilon(1e-12));
+  CHECK(by[1].E_v == doctest::Approx(0).epsilon(1e-12));
+  const gdsr::StrainEnergies all = gdsr::strain_energies(g, X);
+  CHECK(all.faces == 4);
+  CHECK(all.E_u == doctest::Approx(0.02));
+  // Piece indices that do not match the faces are refused.
+  CHECK_THROWS(gdsr::strain_energies_by_piece(g, X, {0, 1}));
+  CHECK_THROWS(gdsr::strain_energies_by_piece(g, X, {0, 0, -1, 0}));
+}
