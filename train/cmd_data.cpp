@@ -489,6 +489,7 @@ struct PreviewArgs {
   bool body = true;
   bool intersections = false;  // paint the faces of intersecting pairs red
   bool penetration = false;    // paint the faces inside the body (outside pinches magenta, pinched cyan)
+  bool strain = false;         // paint faces by their most strained fibre (compressed blue, stretched red)
   double pinch_gap_mm = default_pinch_gap_mm();  // the crease rule of `data check`
   std::string view = "front";  // where the camera is, relative to the body's first pose (Y-up, facing +z)
   int layer = -1;              // >= 0: draw only this cloth layer's faces (0: innermost)
@@ -515,8 +516,40 @@ void set_view(const std::string& view, gdsr::RenderOptions& opt) {
     }
 }
 
-// Labels of the garment's faces for --intersections and --penetration, one colour each.
-enum FaceMark { kPlain, kPinched, kInBody, kIntersecting, kMarks };
+// Labels of the garment's faces for --intersections, --penetration and --strain, one colour each.
+enum FaceMark {
+  kPlain,
+  kPinched,
+  kInBody,
+  kIntersecting,
+  kCompressedMuch,  // --strain: a fibre more than kStrainMuch shorter than in the pattern
+  kCompressed,      // more than kStrainSome shorter
+  kStretched,       // more than kStrainSome longer (and none shorter by more)
+  kStretchedMuch,
+  kMarks
+};
+constexpr double kStrainSome = 0.02, kStrainMuch = 0.05;  // of the fibre's pattern length
+
+// Marks the faces left plain by their fibre strained most (|w| - 1 of the u or the v fibre,
+// gdsr::fibre_stretch); returns the faces marked compressed and stretched.
+std::array<int, 2> mark_strain(const gdsr::GarmentMesh& g, const gdsr::Points3& X, std::vector<int>& mark) {
+  const std::vector<gdsr::Vec2> w = gdsr::fibre_stretch(g, X);
+  std::array<int, 2> n{0, 0};
+  for (size_t f = 0; f < w.size(); ++f) {
+    if (mark[f] != kPlain || !w[f].allFinite()) continue;
+    const double du = w[f].x() - 1, dv = w[f].y() - 1;
+    const double e = std::abs(du) >= std::abs(dv) ? du : dv;
+    const int m = e < -kStrainMuch   ? kCompressedMuch
+                  : e < -kStrainSome ? kCompressed
+                  : e > kStrainMuch  ? kStretchedMuch
+                  : e > kStrainSome  ? kStretched
+                                     : kPlain;
+    mark[f] = m;
+    n[0] += m == kCompressedMuch || m == kCompressed;
+    n[1] += m == kStretchedMuch || m == kStretched;
+  }
+  return n;
+}
 
 // Marks the faces in an intersecting pair (CGAL); returns how many.
 int mark_intersections(const gdsr::TriMesh& g, std::vector<int>& mark) {
@@ -575,7 +608,7 @@ void add_marked(const gdsr::TriMesh& g, const std::vector<int>& mark, const std:
 void draw_through(const gdsr::TriMesh& g, std::vector<int> mark, const std::array<cv::Vec3b, kMarks>& colour,
                   const gdsr::RenderOptions& opt, cv::Mat& img) {
   for (int& m : mark)
-    if (m == kPlain) m = -1;
+    if (m == kPlain || m >= kCompressedMuch) m = -1;  // strain is painted on the surface only
   std::vector<gdsr::TriMesh> parts;
   std::vector<cv::Vec3b> colours;
   add_marked(g, mark, colour, parts, colours);
@@ -632,15 +665,26 @@ void run_preview(const PreviewArgs& a) {
   if (a.penetration && !d.has_body()) gdsr::fail("--penetration", a.data + " has no body");
   const std::string view_note = a.view == "front" ? "" : ", " + a.view;
   std::string lr_note = view_note, hr_note = view_note;
-  auto render = [&](const char* name, const gdsr::TriMesh& whole, const std::vector<int>& layer_of, const cv::Vec3b& c,
-                    std::string& note) {
+  auto render = [&](const char* name, const gdsr::GarmentMesh& garment, const gdsr::TriMesh& whole,
+                    const std::vector<int>& layer_of, const cv::Vec3b& c, std::string& note) {
     std::vector<gdsr::TriMesh> meshes = with_body;
     std::vector<cv::Vec3b> colours(with_body.size(), body_c);
     std::vector<int> mark(whole.F.rows(), kPlain);
     // Marked on the whole garment (a layer's faces crossing another layer's count), then cut to --layer.
     const int crossing = a.intersections ? mark_intersections(whole, mark) : 0;
+    std::vector<int> strained(whole.F.rows(), kPlain);
+    if (a.strain) {
+      const std::array<int, 2> n = mark_strain(garment, whole.V, strained);
+      note += ", " + std::to_string(n[0]) + " compressed / " + std::to_string(n[1]) + " stretched";
+      std::printf("%s: %d faces with a fibre more than %g%% shorter than in the pattern, %d more than %g%% longer\n",
+                  name, n[0], 100 * kStrainSome, n[1], 100 * kStrainSome);
+    }
     gdsr::TriMesh g = whole;
-    if (a.layer >= 0) keep_layer(a.layer, layer_of, g, mark);
+    if (a.layer >= 0) {
+      gdsr::TriMesh cut = whole;
+      keep_layer(a.layer, layer_of, cut, strained);
+      keep_layer(a.layer, layer_of, g, mark);
+    }
     if (a.intersections) {
       const long shown = std::count(mark.begin(), mark.end(), int{kIntersecting});
       note += a.layer >= 0 ? ", " + std::to_string(shown) + "/" + std::to_string(crossing) + " intersect"
@@ -656,16 +700,26 @@ void run_preview(const PreviewArgs& a) {
                   name, in.faces, a.layer >= 0 ? (" on layer " + std::to_string(a.layer)).c_str() : "",
                   1000 * gdsr::ValidityOptions{}.penetration_limit, 1000 * in.deepest, in.pinched);
     }
-    // BGR: cloth, pinched cyan, in the body magenta, intersecting red.
-    const std::array<cv::Vec3b, kMarks> colour = {c, cv::Vec3b(230, 200, 0), cv::Vec3b(200, 40, 200),
-                                                  cv::Vec3b(40, 40, 220)};
+    // Strain under the other marks: they win where a face has both.
+    for (size_t f = 0; f < mark.size(); ++f)
+      if (mark[f] == kPlain) mark[f] = strained[f];
+    // BGR: cloth, pinched cyan, in the body magenta, intersecting red; strain: compressed dark /
+    // light blue, stretched yellow / dark red, the cloth white.
+    const std::array<cv::Vec3b, kMarks> colour = {a.strain ? cv::Vec3b(235, 235, 235) : c,  // strain: white cloth
+                                                  cv::Vec3b(230, 200, 0),
+                                                  cv::Vec3b(200, 40, 200),
+                                                  cv::Vec3b(40, 40, 220),
+                                                  cv::Vec3b(160, 40, 20),
+                                                  cv::Vec3b(240, 190, 120),
+                                                  cv::Vec3b(40, 210, 250),
+                                                  cv::Vec3b(20, 20, 140)};
     add_marked(g, mark, colour, meshes, colours);
     cv::Mat img = gdsr::render_meshes(meshes, colours, opt);
     draw_through(g, mark, colour, opt, img);
     return img;
   };
-  const cv::Mat lr_img = render("LR", lr, d.lr.layer, lr_c, lr_note),
-                hr_img = render("HR", hr, d.hr.layer, hr_c, hr_note);
+  const cv::Mat lr_img = render("LR", d.lr, lr, d.lr.layer, lr_c, lr_note),
+                hr_img = render("HR", d.hr, hr, d.hr.layer, hr_c, hr_note);
   auto what = [&](const gdsr::TriMesh& g) {
     return a.layer >= 0 ? "layer " + std::to_string(a.layer) : std::to_string(g.num_vertices()) + " verts";
   };
@@ -1009,6 +1063,10 @@ void add_data_command(CLI::App& app) {
                  "paint faces with a corner more than 5 mm inside the body magenta, cyan where a second body part "
                  "or a closed crease pinches it (the rule of `data check`), drawn through the body");
   add_pinch_gap_option(prev, pv->pinch_gap_mm, "with --penetration, as for `data check`: ");
+  prev->add_flag("--strain", pv->strain,
+                 "paint faces by their most strained fibre against the pattern: more than 2% / 5% shorter light / dark "
+                 "blue, longer yellow / dark red, the rest of the cloth white (under the marks of --intersections and "
+                 "--penetration)");
   std::vector<std::string> view_names;
   for (const View& v : kViews) view_names.push_back(v.name);
   prev->add_option("--view", pv->view, "camera on the body's front, back, left, right or top")

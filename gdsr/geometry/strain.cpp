@@ -34,14 +34,21 @@ bool degenerate_uv(const GarmentMesh& g, int f, Eigen::Matrix2d& Dm) {
 
 namespace {
 
-// Adds face f's energies to s (sums, not yet means); false for a degenerate UV triangle.
-bool add_face(const GarmentMesh& g, const Points3& X, int f, StrainEnergies& s) {
+// Face f's deformation gradient from UV to 3-D (3 x 2); false for a degenerate UV triangle.
+bool deformation_gradient(const GarmentMesh& g, const Points3& X, int f, Eigen::Matrix<double, 3, 2>& w) {
   Eigen::Matrix2d Dm;
   if (degenerate_uv(g, f, Dm)) return false;
   Eigen::Matrix<double, 3, 2> Ds;
   Ds.col(0) = X.row(g.F(f, 1)) - X.row(g.F(f, 0));
   Ds.col(1) = X.row(g.F(f, 2)) - X.row(g.F(f, 0));
-  const Eigen::Matrix<double, 3, 2> w = Ds * Dm.inverse();
+  w = Ds * Dm.inverse();
+  return true;
+}
+
+// Adds face f's energies to s (sums, not yet means); false for a degenerate UV triangle.
+bool add_face(const GarmentMesh& g, const Points3& X, int f, StrainEnergies& s) {
+  Eigen::Matrix<double, 3, 2> w;
+  if (!deformation_gradient(g, X, f, w)) return false;
   const double lu = w.col(0).norm(), lv = w.col(1).norm(), d = w.col(0).dot(w.col(1));
   s.E_u += (lu - 1) * (lu - 1);
   s.E_v += (lv - 1) * (lv - 1);
@@ -65,6 +72,16 @@ StrainEnergies strain_energies(const GarmentMesh& g, const Points3& X) {
   for (int f = 0; f < g.F.rows(); ++f) add_face(g, X, f, s);
   to_means(s);
   return s;
+}
+
+std::vector<Vec2> fibre_stretch(const GarmentMesh& g, const Points3& X) {
+  check_positions(g, X);
+  std::vector<Vec2> out(g.F.rows(), Vec2::Constant(std::numeric_limits<double>::quiet_NaN()));
+  for (int f = 0; f < g.F.rows(); ++f) {
+    Eigen::Matrix<double, 3, 2> w;
+    if (deformation_gradient(g, X, f, w)) out[f] = Vec2(w.col(0).norm(), w.col(1).norm());
+  }
+  return out;
 }
 
 std::vector<int> pattern_pieces(const GarmentMesh& g) {

@@ -26,6 +26,11 @@ struct StrainEnergies {
 // test) carry no deformation gradient and are left out of the means.
 StrainEnergies strain_energies(const GarmentMesh& g, const Points3& X);
 
+// Per triangle, the lengths |w_u| and |w_v| of its u and v fibres over their pattern lengths
+// (1: as cut, < 1 compressed, > 1 stretched); NaN for a triangle whose UV triangle is
+// degenerate (see above).
+std::vector<Vec2> fibre_stretch(const GarmentMesh& g, const Points3& X);
+
 // The pieces of the flat pattern (its panels): per triangle, the index of its UV island (faces
 // joined through shared UV vertices), islands numbered by their smallest UV x, so in the order
 // the pattern lays its panels out from left to right.

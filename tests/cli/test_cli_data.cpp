@@ -4,6 +4,7 @@
 #include "gdsr/geometry/mesh_ops.hpp"
 #include "gdsr/geometry/obj_io.hpp"
 #include "gdsr/geometry/self_intersections.hpp"
+#include "gdsr/geometry/strain.hpp"
 #include "tests/support/cli_run.hpp"
 #include "tests/support/data_fixtures.hpp"
 
@@ -158,6 +159,27 @@ TEST_CASE("cli data: make a tiny dataset, check it and preview a frame") {
       gdsr_run(dir, "data preview --data '" + out + "' --frame 5 --size 128 --out '" + (dir / "p.png") + "'");
   CHECK(pv.status == 0);
   CHECK(fs::file_size(dir / "p.png") > 1000);
+  // Strain painted on the cloth: the counts printed per resolution, and another picture.
+  const Run pvs =
+      gdsr_run(dir, "data preview --data '" + out + "' --frame 5 --size 128 --strain --out '" + (dir / "ps.png") + "'");
+  CHECK(pvs.status == 0);
+  CHECK(pvs.out.find("LR: ") != std::string::npos);
+  CHECK(pvs.out.find("faces with a fibre more than 2% shorter than in the pattern") != std::string::npos);
+  {  // the LR counts, from each face's fibre strained most (|w| - 1 beyond 2%)
+    const gdsr::Dataset ds = gdsr::load_dataset(out);
+    int shorter = 0, longer = 0;
+    for (const gdsr::Vec2& w : gdsr::fibre_stretch(ds.lr, ds.lr_frames[5])) {
+      const double e = std::abs(w.x() - 1) >= std::abs(w.y() - 1) ? w.x() - 1 : w.y() - 1;
+      shorter += e<-0.02, longer += e> 0.02;
+    }
+    CHECK(shorter + longer > 0);
+    CHECK(pvs.out.find("LR: " + std::to_string(shorter) +
+                       " faces with a fibre more than 2% shorter than in the "
+                       "pattern, " +
+                       std::to_string(longer) + " more than 2% longer") != std::string::npos);
+  }
+  REQUIRE(fs::exists(dir / "ps.png"));
+  CHECK(gdsr_test::slurp(dir / "ps.png") != gdsr_test::slurp(dir / "p.png"));
   const Run pvi =
       gdsr_run(dir, "data preview --data '" + out + "' --intersections --size 128 --out '" + (dir / "pi.png") + "'");
   CHECK(pvi.status == 0);

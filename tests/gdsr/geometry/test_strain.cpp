@@ -120,3 +120,20 @@ TEST_CASE("strain energies by pattern piece: UV islands left to right, each piec
   CHECK_THROWS(gdsr::strain_energies_by_piece(g, X, {0, 1}));
   CHECK_THROWS(gdsr::strain_energies_by_piece(g, X, {0, 0, -1, 0}));
 }
+
+TEST_CASE("strain: each triangle's fibre lengths over the pattern's, NaN where the UV triangle is degenerate") {
+  // x *= 1.5, y *= 0.8: every triangle's u fibre is 1.5 times its pattern length, its v fibre 0.8.
+  gdsr::GarmentMesh g = gdsr_test::grid_garment(gdsr_test::GridSpec(3, 3, 0.2, 0.2));
+  gdsr::Points3 s = g.V;
+  s.col(0) *= 1.5;
+  s.col(1) *= 0.8;
+  g.FUV.row(0) << g.FUV(0, 0), g.FUV(0, 0), g.FUV(0, 2);
+  const std::vector<gdsr::Vec2> w = gdsr::fibre_stretch(g, s);
+  REQUIRE(w.size() == static_cast<size_t>(g.F.rows()));
+  CHECK(std::isnan(w[0].x()));
+  for (size_t f = 1; f < w.size(); ++f) {
+    CHECK(w[f].x() == doctest::Approx(1.5));
+    CHECK(w[f].y() == doctest::Approx(0.8));
+  }
+  CHECK_THROWS_WITH(gdsr::fibre_stretch(g, s.topRows(3)), doctest::Contains("3 positions"));
+}
