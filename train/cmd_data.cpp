@@ -489,7 +489,7 @@ struct PreviewArgs {
   bool body = true;
   bool intersections = false;  // paint the faces of intersecting pairs red
   bool penetration = false;    // paint the faces inside the body (outside pinches magenta, pinched cyan)
-  bool strain = false;         // paint faces by their most strained fibre (compressed blue, stretched red)
+  bool strain = false;         // paint faces by their most strained fibre (shorter blue, longer yellow / red)
   double pinch_gap_mm = default_pinch_gap_mm();  // the crease rule of `data check`
   std::string view = "front";  // where the camera is, relative to the body's first pose (Y-up, facing +z)
   int layer = -1;              // >= 0: draw only this cloth layer's faces (0: innermost)

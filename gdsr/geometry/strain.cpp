@@ -30,10 +30,6 @@ bool degenerate_uv(const GarmentMesh& g, int f, Eigen::Matrix2d& Dm) {
   return !(std::abs(Dm.determinant()) > 1e-8 * scale2);
 }
 
-}  // namespace
-
-namespace {
-
 // Face f's deformation gradient from UV to 3-D (3 x 2); false for a degenerate UV triangle.
 bool deformation_gradient(const GarmentMesh& g, const Points3& X, int f, Eigen::Matrix<double, 3, 2>& w) {
   Eigen::Matrix2d Dm;
