@@ -1,12 +1,14 @@
 #include "gdsr/geometry/mesh_ops.hpp"
 
 #include "gdsr/error.hpp"
+#include "gdsr/geometry/union_find.hpp"
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <utility>
@@ -312,6 +314,29 @@ GarmentMesh subdivide_midpoint(const GarmentMesh& g) {
     for (const auto& [e, id] : vid) s.layer[id] = g.layer[e.first];
   }
   return s;
+}
+
+std::vector<int> uv_islands(const GarmentMesh& g) {
+  const int nuv = static_cast<int>(g.UV.rows());
+  std::vector<int> parent(nuv);
+  for (int i = 0; i < nuv; ++i) parent[i] = i;
+  for (int f = 0; f < g.FUV.rows(); ++f)
+    for (int k = 1; k < 3; ++k) parent[find_root(parent, g.FUV(f, k))] = find_root(parent, g.FUV(f, 0));
+  std::vector<double> min_x(nuv, std::numeric_limits<double>::infinity());
+  for (int i = 0; i < nuv; ++i) {
+    const int r = find_root(parent, i);
+    min_x[r] = std::min(min_x[r], g.UV(i, 0));
+  }
+  std::vector<int> roots;
+  for (int i = 0; i < nuv; ++i)
+    if (parent[i] == i) roots.push_back(i);
+  std::sort(roots.begin(), roots.end(),
+            [&](int a, int b) { return min_x[a] < min_x[b] || (min_x[a] == min_x[b] && a < b); });
+  std::vector<int> index(nuv, -1);
+  for (size_t k = 0; k < roots.size(); ++k) index[roots[k]] = static_cast<int>(k);
+  std::vector<int> island(nuv);
+  for (int i = 0; i < nuv; ++i) island[i] = index[find_root(parent, i)];
+  return island;
 }
 
 }  // namespace gdsr

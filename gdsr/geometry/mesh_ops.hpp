@@ -53,6 +53,11 @@ FacePairs adjacent_face_pairs(const Faces& F);
 // Vertices on a boundary edge (an edge with exactly one face), ascending.
 std::vector<int> boundary_vertices(const Faces& F);
 
+// The UV islands of a flat pattern (its panels): per UV vertex, the index of its island (UV
+// vertices joined through the UV triangles FUV), islands numbered by their smallest UV x, so in
+// the order the pattern lays its panels out from left to right (ties: the lower vertex).
+std::vector<int> uv_islands(const GarmentMesh& g);
+
 // Mean length of the unique edges (metres); 0 for a mesh without edges.
 double mean_edge_length(const Points3& V, const Faces& F);
 

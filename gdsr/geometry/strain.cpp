@@ -1,7 +1,7 @@
 #include "gdsr/geometry/strain.hpp"
 
 #include "gdsr/error.hpp"
-#include "gdsr/geometry/union_find.hpp"
+#include "gdsr/geometry/mesh_ops.hpp"
 
 #include <Eigen/Dense>
 
@@ -81,27 +81,9 @@ std::vector<Vec2> fibre_stretch(const GarmentMesh& g, const Points3& X) {
 }
 
 std::vector<int> pattern_pieces(const GarmentMesh& g) {
-  const int nuv = static_cast<int>(g.UV.rows());
-  std::vector<int> parent(nuv);
-  for (int i = 0; i < nuv; ++i) parent[i] = i;
-  for (int f = 0; f < g.FUV.rows(); ++f)
-    for (int k = 1; k < 3; ++k) parent[find_root(parent, g.FUV(f, k))] = find_root(parent, g.FUV(f, 0));
-  // Each island's smallest UV x, then the islands in that order (ties: the lower root).
-  std::vector<double> min_x(nuv, std::numeric_limits<double>::infinity());
-  for (int f = 0; f < g.FUV.rows(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int r = find_root(parent, g.FUV(f, k));
-      min_x[r] = std::min(min_x[r], g.UV(g.FUV(f, k), 0));
-    }
-  std::vector<int> roots;
-  for (int i = 0; i < nuv; ++i)
-    if (std::isfinite(min_x[i])) roots.push_back(i);
-  std::sort(roots.begin(), roots.end(),
-            [&](int a, int b) { return min_x[a] < min_x[b] || (min_x[a] == min_x[b] && a < b); });
-  std::vector<int> index(nuv, -1);
-  for (size_t k = 0; k < roots.size(); ++k) index[roots[k]] = static_cast<int>(k);
+  const std::vector<int> island = uv_islands(g);
   std::vector<int> piece(g.FUV.rows());
-  for (int f = 0; f < g.FUV.rows(); ++f) piece[f] = index[find_root(parent, g.FUV(f, 0))];
+  for (int f = 0; f < g.FUV.rows(); ++f) piece[f] = island[g.FUV(f, 0)];
   return piece;
 }
 

@@ -31,9 +31,8 @@ StrainEnergies strain_energies(const GarmentMesh& g, const Points3& X);
 // degenerate (see above).
 std::vector<Vec2> fibre_stretch(const GarmentMesh& g, const Points3& X);
 
-// The pieces of the flat pattern (its panels): per triangle, the index of its UV island (faces
-// joined through shared UV vertices), islands numbered by their smallest UV x, so in the order
-// the pattern lays its panels out from left to right.
+// The pieces of the flat pattern (its panels): per triangle, the index of its UV island
+// (gdsr::uv_islands, numbered left to right as the pattern lays its panels out).
 std::vector<int> pattern_pieces(const GarmentMesh& g);
 
 // strain_energies over each piece's triangles alone: element k for piece k of `piece`

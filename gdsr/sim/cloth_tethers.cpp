@@ -1,6 +1,7 @@
 #include "gdsr/sim/cloth_tethers.hpp"
 
 #include "gdsr/error.hpp"
+#include "gdsr/geometry/mesh_ops.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,22 +11,6 @@
 #include <utility>
 
 namespace sim {
-
-namespace {
-
-// UV chart of every UV vertex: connected components of the FUV triangles.
-std::vector<int> uv_charts(const gdsr::GarmentMesh& m) {
-  std::vector<int> parent(m.UV.rows());
-  for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
-  std::function<int(int)> root = [&](int i) { return parent[i] == i ? i : parent[i] = root(parent[i]); };
-  for (int f = 0; f < m.FUV.rows(); ++f)
-    for (int k = 1; k < 3; ++k) parent[root(m.FUV(f, k))] = root(m.FUV(f, 0));
-  std::vector<int> chart(parent.size());
-  for (size_t i = 0; i < parent.size(); ++i) chart[i] = root(static_cast<int>(i));
-  return chart;
-}
-
-}  // namespace
 
 std::vector<Tether> make_tethers(const gdsr::GarmentMesh& m, const std::vector<int>& pinned) {
   const int nv = static_cast<int>(m.V.rows());
@@ -68,7 +53,7 @@ std::vector<Tether> make_tethers(const gdsr::GarmentMesh& m, const std::vector<i
     }
   }
   // Straight lines in the flat pattern where both ends share a chart.
-  const std::vector<int> chart = uv_charts(m);
+  const std::vector<int> chart = gdsr::uv_islands(m);
   std::vector<std::vector<int>> copies(nv);
   for (size_t u = 0; u < m.uv_to_vertex.size(); ++u) copies[m.uv_to_vertex[u]].push_back(static_cast<int>(u));
   std::vector<Tether> out;

@@ -209,3 +209,19 @@ TEST_CASE("mesh_ops: midpoint subdivision keeps 3-D and UV consistent") {
     CHECK(area(s.UV, s.FUV, f) == doctest::Approx(area(g.UV, g.FUV, f / 4) / 4).epsilon(1e-12));
   }
 }
+
+TEST_CASE("mesh_ops: UV islands numbered left to right, an unused UV vertex on its own") {
+  // Two UV triangles far apart in the pattern, the right one first in FUV, and a UV vertex no
+  // triangle uses, leftmost of all.
+  gdsr::GarmentMesh g;
+  g.UV.resize(7, 2);
+  g.UV << 5, 0, 6, 0, 5, 1,  // right triangle
+      1, 0, 2, 0, 1, 1,      // left triangle
+      -3, 0;                 // unused
+  g.FUV.resize(2, 3);
+  g.FUV << 0, 1, 2, 3, 4, 5;
+  CHECK(gdsr::uv_islands(g) == std::vector<int>{2, 2, 2, 1, 1, 1, 0});
+  // Joined through a shared UV vertex, the two are one island.
+  g.FUV << 0, 1, 3, 3, 4, 5;
+  CHECK(gdsr::uv_islands(g) == std::vector<int>{1, 1, 2, 1, 1, 1, 0});
+}
