@@ -76,6 +76,7 @@ struct MakeArgs {
   double contact_travel = NAN;
   double arm_clearance = 0.01;  // metres, gdsr::BodyOptions::arm_clearance (0: the motion as in the file)
   double min_shoulder_half_width = gdsr::BodyOptions{}.min_shoulder_half_width;  // metres (0: as in the file)
+  double body_yield_gap = 0;  // metres, gdsr::BodyOptions::yield_gap (0: the skinned surface as it is)
   double pin_yield_rate = NAN;
   double track_rate = NAN;  // 1/s: the HR simulation follows the LR one at the LR scale (sim/cloth_tracking.hpp)
   bool self_collision = true;
@@ -189,6 +190,7 @@ void run_make(const MakeArgs& a) {
   bo.rest_arm_drop_degrees = sim::rest_arm_drop_degrees(a.garment);
   bo.arm_clearance = a.arm_clearance;
   bo.min_shoulder_half_width = a.min_shoulder_half_width;
+  bo.yield_gap = a.body_yield_gap;
   const double t_body = now_seconds();
   const gdsr::BodySequence body = gdsr::load_body_sequence(a.motion, bo);
   std::printf("body: %s, %d frames at %g fps (%d rest blend), %ld vertices, %.1f s\n", a.motion.c_str(),
@@ -208,6 +210,11 @@ void run_make(const MakeArgs& a) {
         "up to %.1f degrees (%d frames still inside after the largest turn)\n",
         1e3 * bo.arm_clearance, body.arm_turns.turned_frames(), body.arm_turns.max_degrees(),
         body.arm_turns.still_inside_frames);
+  if (body.yields.yielded_frames() > 0)
+    std::printf(
+        "body: one part passed into another in %d frames; both gave way, by up to %.1f mm (%d frames still "
+        "overlapping after the last pass)\n",
+        body.yields.yielded_frames(), 1e3 * body.yields.max_move_overall(), body.yields.buried_left_frames);
   if (!body.torso_found)
     std::fprintf(stderr,
                  "warning: %s: no hips and shoulders found among the skeleton's joint names; the body is a "
@@ -298,6 +305,9 @@ void run_make(const MakeArgs& a) {
                   {"shoulders_widened", body.shoulders_widened},
                   {"arm_turned_frames", body.arm_turns.turned_frames()},
                   {"arm_turn_max_degrees", body.arm_turns.max_degrees()},
+                  {"body_yield_gap_m", bo.yield_gap},
+                  {"body_yielded_frames", body.yields.yielded_frames()},
+                  {"body_yield_max_mm", 1e3 * body.yields.max_move_overall()},
                   {"arm_still_inside_frames", body.arm_turns.still_inside_frames},
                   {"self_collision", params.self_collision},
                   {"limbs_pass_through", params.limbs_pass_through},
@@ -383,6 +393,10 @@ bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why
     }
     if (!same(sp.value("arm_clearance_m", 0.0), a.arm_clearance)) {
       why = "built with another arm clearance";
+      return false;
+    }
+    if (!same(sp.value("body_yield_gap_m", 0.0), a.body_yield_gap)) {
+      why = "built with another body yield gap";
       return false;
     }
     // Another limit changes nothing when the file's shoulders are wider than both.
@@ -1022,6 +1036,12 @@ void add_data_command(CLI::App& app) {
                    "the file")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.1));
+  make->add_option("--body-yield-gap", mk->body_yield_gap,
+                   "metres: where skinning drives one body part into another (a thigh raised into the belly), "
+                   "both surfaces give way, each half the overlap, to meet this far apart, as flesh does; 0: "
+                   "the skinned surface as it is")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.049));
   make->add_option("--min-shoulder-half-width", mk->min_shoulder_half_width,
                    "metres: a skeleton whose shoulder joints are closer than this to the middle has them moved "
                    "out to it (the CMU salsa BVHs' 0.126 m hang the arms inside the trunk); 0: as in the file")

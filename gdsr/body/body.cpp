@@ -3,6 +3,7 @@
 #include "gdsr/error.hpp"
 
 #include "gdsr/body/body_query.hpp"
+#include "gdsr/body/body_yield.hpp"
 #include "gdsr/body/skeleton_body.hpp"
 #include "gdsr/geometry/mesh_ops.hpp"
 
@@ -543,6 +544,42 @@ std::vector<Points3> skin_frames(const Rig& rig, const Skin& sk, const ToMetres&
   return frames;
 }
 
+// Per body vertex, the limb segment of its heaviest influence (detail::limb_segments; -1: the
+// trunk, or a node outside the skeleton).
+std::vector<int> vertex_segments(const Rig& rig, const Skin& sk, const std::string& path) {
+  const SkeletonNodes sn = skeleton_nodes(rig, rig.globals(rig.rest), path);
+  const std::vector<int> seg = detail::limb_segments(sn.nodes);
+  std::vector<int> of_rig(rig.node.size(), -1);
+  for (size_t k = 0; k < sn.nodes.size(); ++k) of_rig[sn.to_rig[k]] = seg[k];
+  std::vector<int> out(sk.P.rows(), -1);
+  for (Eigen::Index i = 0; i < sk.P.rows(); ++i) {
+    int heaviest = sk.start[i];
+    for (int k = sk.start[i] + 1; k < sk.start[i + 1]; ++k)
+      if (sk.weight[k] > sk.weight[heaviest]) heaviest = k;
+    out[i] = of_rig[sk.mat_node[sk.mat[heaviest]]];
+  }
+  return out;
+}
+
+// BodyOptions::yield_gap: every frame's overlaps given way (parallel over frames).
+BodyYields yield_frames(const Faces& F, const Points3& rest, const std::vector<int>& segment, double gap,
+                        std::vector<Points3>& frames) {
+  BodyYields out;
+  const int T = static_cast<int>(frames.size());
+  out.max_move.assign(T, 0.0);
+  std::vector<char> left(T, 0);
+  BodyYieldOptions yo;
+  yo.gap = gap;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int f = 0; f < T; ++f) {
+    const BodyYield y = yield_self_overlap(F, frames[f], rest, segment, yo);
+    out.max_move[f] = y.max_move;
+    left[f] = y.buried_left > 0;
+  }
+  out.buried_left_frames = static_cast<int>(std::count(left.begin(), left.end(), 1));
+  return out;
+}
+
 // Arm clearance (BodyOptions::arm_clearance). An arm is told from the rest of the body by
 // skin: a vertex belongs to an arm when its heaviest influence is a node under that upper arm.
 // Only arm vertices farther than kArmPartSeparation from the rest of the body at the build pose
@@ -764,11 +801,12 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
   if (!(opt.fps > 0) || !(opt.height > 0) || opt.rest_blend_frames < 0 || !(opt.start_seconds >= 0) ||
       !(opt.body_edge > 0) || !(opt.rest_arm_drop_degrees <= 80) || !(opt.arm_clearance >= 0) ||
       !(opt.max_arm_turn_degrees > 0 && opt.max_arm_turn_degrees <= 90) || !(opt.arm_turn_ease_seconds >= 0) ||
-      !(opt.min_shoulder_half_width >= 0 && opt.min_shoulder_half_width < 0.5))
+      !(opt.min_shoulder_half_width >= 0 && opt.min_shoulder_half_width < 0.5) ||
+      !(opt.yield_gap >= 0 && opt.yield_gap < 0.05))
     gdsr::fail("load_body_sequence: " + path,
                "bad BodyOptions (fps, height, body_edge must be > 0, rest_blend_frames and start_seconds >= 0, "
                "rest_arm_drop_degrees <= 80, arm_clearance >= 0, max_arm_turn_degrees in (0, 90], "
-               "arm_turn_ease_seconds >= 0, min_shoulder_half_width in [0, 0.5) m)");
+               "arm_turn_ease_seconds >= 0, min_shoulder_half_width in [0, 0.5) m, yield_gap in [0, 0.05) m)");
   if (!std::ifstream(path).good()) gdsr::fail("load_body_sequence: " + path, "file not found or not readable");
   Assimp::Importer imp;
   const aiScene* s =
@@ -825,6 +863,8 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
       seq.arm_turns = clear_arms(clip.rig, surf.sk, to_out, parts, opt, poses);
     }
     seq.frames = skin_frames(clip.rig, surf.sk, to_out, poses, path);
+    if (opt.yield_gap > 0)
+      seq.yields = yield_frames(seq.F, seq.rest_V, vertex_segments(clip.rig, surf.sk, path), opt.yield_gap, seq.frames);
   }
   seq.landmarks = measure_landmarks(TriMesh{seq.rest_V, seq.F}, surf, to_out, clip.skinned, opt.height);
   return seq;

@@ -66,6 +66,26 @@ struct BodyOptions {
   // narrower shoulders hang the arms inside it (the CMU salsa BVHs: 0.126 m; CMU 01: 0.213 m,
   // CMU 131: 0.204 m). 0: the joints where the file has them.
   double min_shoulder_half_width = 0.20;
+  // > 0: where skinning drives one part of the body into another (a thigh raised into the belly,
+  // a forearm folded onto the upper arm), both surfaces give way, each half the overlap, to meet
+  // this many metres apart, as flesh does (gdsr/body/body_yield.hpp). 0: the skinned surface as it is.
+  double yield_gap = 0;
+};
+
+// How BodyOptions::yield_gap changed the frames.
+struct BodyYields {
+  std::vector<double> max_move;  // per frame, m: the largest move of a vertex (0: as skinned)
+  int buried_left_frames = 0;    // frames with vertices still inside another part after the last pass
+  int yielded_frames() const {
+    int n = 0;
+    for (double d : max_move) n += d > 0;
+    return n;
+  }
+  double max_move_overall() const {
+    double m = 0;
+    for (double d : max_move) m = d > m ? d : m;
+    return m;
+  }
 };
 
 // How BodyOptions::arm_clearance changed the motion.
@@ -119,6 +139,7 @@ struct BodySequence {
   // of capsules; `gdsr data make` warns). Always true for skinned meshes.
   bool torso_found = true;
   ArmTurns arm_turns;  // empty degrees unless BodyOptions::arm_clearance > 0
+  BodyYields yields;   // empty max_move unless BodyOptions::yield_gap > 0
   // Skeleton bodies with two upper arms: the shoulder joints' distance from the middle as in
   // the file, metres (0: not measured), and whether BodyOptions::min_shoulder_half_width moved them.
   double captured_shoulder_half_width = 0;

@@ -445,6 +445,22 @@ std::vector<int> upper_arm_starts(const std::vector<SkelNode>& nodes) {
   return analyse(nodes, 1.0).arms;
 }
 
+std::vector<int> limb_segments(const std::vector<SkelNode>& nodes) {
+  const int n = static_cast<int>(nodes.size());
+  std::vector<int> seg(n, -1);
+  if (n < 2) return seg;
+  const Skeleton sk = analyse(nodes, 1.0);
+  auto limb = [](Part p) { return p == Part::UpperArm || p == Part::ForeArm || p == Part::Thigh || p == Part::Shin; };
+  for (int i = 0; i < n; ++i) {  // parents come before children
+    const int par = nodes[i].parent;
+    if (limb(sk.part[i]))
+      seg[i] = par >= 0 && sk.part[par] == sk.part[i] ? seg[par] : i;
+    else if (par >= 0 && sk.part[i] != Part::Torso && sk.part[i] != Part::Clavicle)
+      seg[i] = seg[par];
+  }
+  return seg;
+}
+
 SkinnedBody build_skeleton_body(const std::vector<SkelNode>& nodes_in, double mpu, double edge) {
   if (nodes_in.size() < 2) gdsr::fail("build_skeleton_body", "skeleton has fewer than 2 nodes");
   const Skeleton sk = analyse(nodes_in, mpu);

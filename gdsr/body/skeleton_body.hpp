@@ -36,6 +36,11 @@ struct SkinnedBody {
 // The nodes that start the upper arms, recognised by name as build_skeleton_body does.
 std::vector<int> upper_arm_starts(const std::vector<SkelNode>& nodes);
 
+// Per node, the limb segment it moves with: the first node of its run of upper-arm, forearm,
+// thigh or shin nodes (hands follow their forearm, feet and toes their shin), or -1 for the
+// trunk, neck, head and clavicles.
+std::vector<int> limb_segments(const std::vector<SkelNode>& nodes);
+
 // metres_per_unit: scale of the file units (radii are in metres); edge: target triangle
 // circumradius, metres. Throws if the skeleton has no recognisable body (fewer than 2 nodes).
 SkinnedBody build_skeleton_body(const std::vector<SkelNode>& nodes, double metres_per_unit, double edge);

@@ -534,6 +534,28 @@ TEST_CASE(
   check_one_line_error(gdsr_run(dir, cmd + " --min-shoulder-half-width 0.5"), "--min-shoulder-half-width");
 }
 
+TEST_CASE("cli data: --body-yield-gap gives way where the kneel drives the thigh into the belly, said and recorded") {
+  // gdsr::BodyOptions::yield_gap (tests/gdsr/body/test_body_yield.cpp measures the body with CGAL).
+  TempDir dir("cli_body_yield");
+  const std::string out = dir / "ds";
+  const std::string cmd = "data make --skip-built --garment skirt_short --motion '" + std::string(GDSR_SHARED_DIR) +
+                          "/motions/cmu-walk/131_01.bvh' --start 3.1 --out '" + out +
+                          "' --seconds 0.1 --lr-pd 0.08 --hr-pd 0.06 --rest-blend 2 --raster 64 --settle-frames 3";
+  const Run plain = gdsr_run(dir, cmd);
+  REQUIRE(plain.status == 0);
+  CHECK(plain.out.find("gave way") == std::string::npos);
+  CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"body_yield_gap_m\": 0.0") != std::string::npos);
+  const Run yielded = gdsr_run(dir, cmd + " --body-yield-gap 0.004");
+  REQUIRE(yielded.status == 0);
+  CHECK(yielded.out.find("built with another body yield gap") != std::string::npos);
+  CHECK(yielded.out.find("body: one part passed into another in") != std::string::npos);
+  const std::string manifest = gdsr_test::slurp(out + "/manifest.json");
+  CHECK(manifest.find("\"body_yield_gap_m\": 0.004") != std::string::npos);
+  CHECK(manifest.find("\"body_yielded_frames\": 0,") == std::string::npos);
+  CHECK(gdsr_run(dir, cmd + " --body-yield-gap 0.004").out.find("kept") != std::string::npos);
+  check_one_line_error(gdsr_run(dir, cmd + " --body-yield-gap 0.05"), "--body-yield-gap");
+}
+
 TEST_CASE("cli data: compare finds a repeat bit-identical, a nudged twin apart, and refuses other meshes") {
   TempDir dir("cli_compare");
   const std::string clip = " --garment skirt_short --seconds 0.2 --hr-pd 0.06 --rest-blend 2 --raster 64"
