@@ -72,36 +72,32 @@ struct BodyOptions {
   double yield_gap = 0;
 };
 
+// Of a per-frame amount of change (0: the frame as it was): the frames changed, the largest.
+inline int frames_changed(const std::vector<double>& per_frame) {
+  int n = 0;
+  for (double d : per_frame) n += d > 0;
+  return n;
+}
+inline double largest_change(const std::vector<double>& per_frame) {
+  double m = 0;
+  for (double d : per_frame) m = d > m ? d : m;
+  return m;
+}
+
 // How BodyOptions::yield_gap changed the frames.
 struct BodyYields {
   std::vector<double> max_move;  // per frame, m: the largest move of a vertex (0: as skinned)
   int buried_left_frames = 0;    // frames with vertices still inside another part after the last pass
-  int yielded_frames() const {
-    int n = 0;
-    for (double d : max_move) n += d > 0;
-    return n;
-  }
-  double max_move_overall() const {
-    double m = 0;
-    for (double d : max_move) m = d > m ? d : m;
-    return m;
-  }
+  int yielded_frames() const { return frames_changed(max_move); }
+  double max_move_overall() const { return largest_change(max_move); }
 };
 
 // How BodyOptions::arm_clearance changed the motion.
 struct ArmTurns {
   std::vector<double> degrees;  // per frame, the larger of the two arms' turns (0: as in the file)
   int still_inside_frames = 0;  // turned frames where an arm still enters the body (the turn capped)
-  int turned_frames() const {
-    int n = 0;
-    for (double d : degrees) n += d > 0;
-    return n;
-  }
-  double max_degrees() const {
-    double m = 0;
-    for (double d : degrees) m = d > m ? d : m;
-    return m;
-  }
+  int turned_frames() const { return frames_changed(degrees); }
+  double max_degrees() const { return largest_change(degrees); }
 };
 
 // A horizontal cross-section of the rest-pose body (torso only: points within 0.35 m of

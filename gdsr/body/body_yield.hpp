@@ -15,9 +15,10 @@
 // tip, leaves the rest to the next pass).
 // Another part: every corner of the face lies in another limb segment (per-vertex labels, a
 // thigh, a forearm, the trunk) and was farther than part_separation from the vertex in the
-// rest pose (as the validity figures' "body crosses itself"); the ray passes the vertex's own
+// rest pose (the validity figures' "body crosses itself" counts faces 0.15 m apart; 0.10 also
+// takes the belly and the inner thigh, 10-17 cm apart at the hip crease); the ray passes the vertex's own
 // segment's faces. A buried vertex whose ray meets a neighbouring segment's face near it in
-// the rest pose first (across a joint), enters another part, or meets none, is a fold of the
+// the rest pose first (across a joint), enters another part, or meets none within max_depth, is a fold of the
 // skin in a joint's crease (an armpit), not flesh pressed on flesh, and stays as skinned.
 // Positions in metres. Deterministic; surfaces that do not pass through themselves are
 // returned bit for bit.
@@ -31,7 +32,7 @@ namespace gdsr {
 
 struct BodyYieldOptions {
   double gap = 0.004;             // m: the two sides end at least about this far apart at the vertices
-  double max_depth = 0.10;        // m: deeper overlaps are moved this far per pass, no more
+  double max_depth = 0.10;        // m: a vertex whose ray finds no other part within this stays as skinned
   int max_passes = 12;            // passes over the moved surface
   double part_separation = 0.10;  // m, in the rest pose: farther apart are two parts (a thigh and the belly)
   double dent_falloff = 0.02;     // m: a buried vertex moving d takes its part's surface within this + d along
