@@ -676,6 +676,22 @@ void run_preview(const PreviewArgs& a) {
   const cv::Vec3b body_c(200, 200, 200), lr_c(70, 120, 230), hr_c(60, 170, 90);  // BGR
   std::vector<gdsr::TriMesh> with_body;
   if (a.body && d.has_body()) with_body.push_back(gdsr::TriMesh{d.body_frames[t], d.body_faces});
+  // --intersections: the body's faces where one part passes into another (the rule of `data check`).
+  gdsr::TriMesh body_crossing;
+  if (a.intersections && !with_body.empty()) {
+    const auto pairs = gdsr::body_crossing_pairs(d.body_frames[t], d.body_faces, d.body_frames[0],
+                                                 gdsr::ValidityOptions{}.pinch_separation);
+    std::vector<int> faces;
+    for (const auto& [f, g] : pairs) faces.insert(faces.end(), {f, g});
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    body_crossing.V = d.body_frames[t];
+    body_crossing.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+    for (size_t i = 0; i < faces.size(); ++i)
+      body_crossing.F.row(static_cast<Eigen::Index>(i)) = d.body_faces.row(faces[i]);
+    std::printf("body: %zu faces where one part passes into another (CGAL, parts %g m apart in the first frame)\n",
+                faces.size(), gdsr::ValidityOptions{}.pinch_separation);
+  }
   if (a.penetration && !d.has_body()) gdsr::fail("--penetration", a.data + " has no body");
   const std::string view_note = a.view == "front" ? "" : ", " + a.view;
   std::string lr_note = view_note, hr_note = view_note;
@@ -730,6 +746,9 @@ void run_preview(const PreviewArgs& a) {
     add_marked(g, mark, colour, meshes, colours);
     cv::Mat img = gdsr::render_meshes(meshes, colours, opt);
     draw_through(g, mark, colour, opt, img);
+    if (body_crossing.F.rows() > 0)  // orange, drawn through the cloth
+      draw_through(body_crossing, std::vector<int>(body_crossing.F.rows(), kIntersecting),
+                   {cv::Vec3b(), cv::Vec3b(), cv::Vec3b(), cv::Vec3b(0, 140, 255)}, opt, img);
     return img;
   };
   const cv::Mat lr_img = render("LR", d.lr, lr, d.lr.layer, lr_c, lr_note),

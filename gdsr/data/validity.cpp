@@ -214,16 +214,22 @@ double mean_distance(const Points3& a, const Points3& b) {
 
 // Two body faces intersect (CGAL) whose vertices were all farther than sep apart in the first
 // frame, rest: two parts, one inside the other (validity.hpp).
-bool body_crosses_itself(const Points3& V, const Faces& F, const Points3& rest, double sep) {
+std::vector<std::pair<int, int>> body_crossing_pairs(const Points3& V, const Faces& F, const Points3& rest,
+                                                     double sep) {
   const SelfIntersections si = self_intersections(V, F, /*list_pairs=*/true);
   const double sep2 = sep * sep;
+  std::vector<std::pair<int, int>> out;
   for (const auto& [f, g] : si.list) {
     bool apart = true;
     for (int a = 0; a < 3 && apart; ++a)
       for (int b = 0; b < 3 && apart; ++b) apart = (rest.row(F(f, a)) - rest.row(F(g, b))).squaredNorm() > sep2;
-    if (apart) return true;
+    if (apart) out.emplace_back(f, g);
   }
-  return false;
+  return out;
+}
+
+bool body_crosses_itself(const Points3& V, const Faces& F, const Points3& rest, double sep) {
+  return !body_crossing_pairs(V, F, rest, sep).empty();
 }
 
 std::string validity_per_frame_csv(const ValidityFigures& v) {

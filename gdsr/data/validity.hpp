@@ -45,6 +45,7 @@
 #include <nlohmann/json.hpp>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace gdsr {
@@ -160,6 +161,8 @@ BodyDepths body_depths(const Dataset& d, int t, const Points3& X, const Validity
 // were all farther than sep metres apart in `rest` (its first frame): one part inside another,
 // as counted by ValidityFigures::body_crossing_frames with sep = pinch_separation.
 bool body_crosses_itself(const Points3& V, const Faces& F, const Points3& rest, double sep);
+// ... and those pairs of faces (f, g), f < g, sorted.
+std::vector<std::pair<int, int>> body_crossing_pairs(const Points3& V, const Faces& F, const Points3& rest, double sep);
 
 // The per-frame figures as CSV text: a header, then one line per frame (frame, LR and HR
 // intersecting pairs with -1 for unchecked frames, LR and HR depth outside pinches in mm,

@@ -534,17 +534,30 @@ TEST_CASE(
   check_one_line_error(gdsr_run(dir, cmd + " --min-shoulder-half-width 0.5"), "--min-shoulder-half-width");
 }
 
-TEST_CASE("cli data: --body-yield-gap gives way where the kneel drives the thigh into the belly, said and recorded") {
+TEST_CASE(
+    "cli data: --body-yield-gap gives way where the kneel drives the thigh into the belly, said, recorded and "
+    "previewed") {
   // gdsr::BodyOptions::yield_gap (tests/gdsr/body/test_body_yield.cpp measures the body with CGAL).
   TempDir dir("cli_body_yield");
   const std::string out = dir / "ds";
   const std::string cmd = "data make --skip-built --garment skirt_short --motion '" + std::string(GDSR_SHARED_DIR) +
                           "/motions/cmu-walk/131_01.bvh' --start 3.1 --out '" + out +
                           "' --seconds 0.1 --lr-pd 0.08 --hr-pd 0.06 --rest-blend 2 --raster 64 --settle-frames 3";
+  // `data preview --intersections` counts the body's faces where one part passes into another.
+  auto body_crossing_faces = [&]() {
+    const Run pv = gdsr_run(
+        dir, "data preview --intersections --size 64 --frame 3 --data '" + out + "' --out '" + (dir / "p.png") + "'");
+    REQUIRE(pv.status == 0);
+    const size_t at = pv.out.find("body: ");
+    REQUIRE(at != std::string::npos);
+    CHECK(pv.out.find(" faces where one part passes into another (CGAL", at) != std::string::npos);
+    return std::stoi(pv.out.substr(at + 6));
+  };
   const Run plain = gdsr_run(dir, cmd);
   REQUIRE(plain.status == 0);
   CHECK(plain.out.find("gave way") == std::string::npos);
   CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"body_yield_gap_m\": 0.0") != std::string::npos);
+  CHECK(body_crossing_faces() > 50);  // the raised thigh in the belly: 81 faces
   const Run yielded = gdsr_run(dir, cmd + " --body-yield-gap 0.004");
   REQUIRE(yielded.status == 0);
   CHECK(yielded.out.find("built with another body yield gap") != std::string::npos);
@@ -552,6 +565,7 @@ TEST_CASE("cli data: --body-yield-gap gives way where the kneel drives the thigh
   const std::string manifest = gdsr_test::slurp(out + "/manifest.json");
   CHECK(manifest.find("\"body_yield_gap_m\": 0.004") != std::string::npos);
   CHECK(manifest.find("\"body_yielded_frames\": 0,") == std::string::npos);
+  CHECK(body_crossing_faces() == 0);
   CHECK(gdsr_run(dir, cmd + " --body-yield-gap 0.004").out.find("kept") != std::string::npos);
   check_one_line_error(gdsr_run(dir, cmd + " --body-yield-gap 0.05"), "--body-yield-gap");
 }
