@@ -9,7 +9,9 @@
 
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <string>
+#include <vector>
 
 using namespace gdsr;
 
@@ -71,6 +73,11 @@ TEST_CASE("body_yield: two overlapping spheres give way to meet gap apart at the
   CHECK(fold.V == before);
   CHECK_THROWS_WITH_AS(yield_self_overlap(fold.F, fold.V, rest.topRows(10), {}, opt),
                        "yield_self_overlap: rest pose and frame differ in vertex count", Error);
+  CHECK_THROWS_WITH_AS(yield_self_overlap(fold.F, fold.V, rest, std::vector<int>(10, 0), opt),
+                       "yield_self_overlap: segment labels and frame differ in vertex count", Error);
+  // A non-finite vertex is refused (by the ray caster), not carried into the frame.
+  fold.V(5, 1) = std::nan("");
+  CHECK_THROWS_AS(yield_self_overlap(fold.F, fold.V, rest, {}, opt), Error);
 }
 
 TEST_CASE("body_yield: a surface that does not pass through itself is returned bit for bit") {
@@ -119,4 +126,23 @@ TEST_CASE("body_yield: the kneel of CMU 131_01 no longer passes the thigh into t
   // Off by default.
   CHECK(BodyOptions{}.yield_gap == 0);
   CHECK(skinned.yields.max_move.empty());
+}
+
+TEST_CASE("body_yield: a limb pressed into the trunk, told apart by segment labels, gives way by the overlap") {
+  // A "thigh" sphere of radius 0.08 m whose surface reaches 2 cm into a "trunk" sphere of radius
+  // 0.15 m; in the rest pose they stand apart.
+  const TriMesh trunk = sim::make_sphere(Vec3(0, 0, 0), 0.15, 32, 64);
+  TriMesh m = sim::merge_meshes(trunk, sim::make_sphere(Vec3(0.21, 0, 0), 0.08, 24, 48));
+  const Eigen::Index nt = trunk.V.rows();
+  Points3 rest = m.V;
+  rest.bottomRows(m.V.rows() - nt).col(0).array() += 0.5;
+  std::vector<int> segment(m.V.rows(), 0);
+  std::fill(segment.begin() + nt, segment.end(), 1);
+  REQUIRE(self_intersections(m.V, m.F).pairs > 0);
+  const BodyYield y = yield_self_overlap(m.F, m.V, rest, segment);
+  CHECK(y.vertices_moved > 0);
+  CHECK(y.buried_left == 0);
+  CHECK(self_intersections(m.V, m.F).pairs == 0);
+  // Each side half the 20 mm overlap plus half the 4 mm gap, on the axis; less off it.
+  CHECK(y.max_move == doctest::Approx(0.5 * (0.02 + 0.004)).epsilon(0.1));
 }
