@@ -544,6 +544,14 @@ std::vector<Points3> skin_frames(const Rig& rig, const Skin& sk, const ToMetres&
   return frames;
 }
 
+// The rig node of vertex i's heaviest skin influence.
+int heaviest_node(const Skin& sk, Eigen::Index i) {
+  int heaviest = sk.start[i];
+  for (int k = sk.start[i] + 1; k < sk.start[i + 1]; ++k)
+    if (sk.weight[k] > sk.weight[heaviest]) heaviest = k;
+  return sk.mat_node[sk.mat[heaviest]];
+}
+
 // Per body vertex, the limb segment of its heaviest influence (detail::limb_segments; -1: the
 // trunk, or a node outside the skeleton).
 std::vector<int> vertex_segments(const Rig& rig, const Skin& sk, const std::string& path) {
@@ -552,12 +560,7 @@ std::vector<int> vertex_segments(const Rig& rig, const Skin& sk, const std::stri
   std::vector<int> of_rig(rig.node.size(), -1);
   for (size_t k = 0; k < sn.nodes.size(); ++k) of_rig[sn.to_rig[k]] = seg[k];
   std::vector<int> out(sk.P.rows(), -1);
-  for (Eigen::Index i = 0; i < sk.P.rows(); ++i) {
-    int heaviest = sk.start[i];
-    for (int k = sk.start[i] + 1; k < sk.start[i + 1]; ++k)
-      if (sk.weight[k] > sk.weight[heaviest]) heaviest = k;
-    out[i] = of_rig[sk.mat_node[sk.mat[heaviest]]];
-  }
+  for (Eigen::Index i = 0; i < sk.P.rows(); ++i) out[i] = of_rig[heaviest_node(sk, i)];
   return out;
 }
 
@@ -616,13 +619,9 @@ ArmParts arm_parts(const Rig& rig, const Skin& sk, const Points3& rest, const st
   for (int a : starts) parts.rig_node.push_back(sn.to_rig[a]);
   const Eigen::Index nv = sk.P.rows();
   std::vector<int> arm_of(nv, -1);
-  for (Eigen::Index i = 0; i < nv; ++i) {
-    int heaviest = sk.start[i];
-    for (int k = sk.start[i] + 1; k < sk.start[i + 1]; ++k)
-      if (sk.weight[k] > sk.weight[heaviest]) heaviest = k;
+  for (Eigen::Index i = 0; i < nv; ++i)
     for (int a = 0; a < 2; ++a)
-      if (under(rig, sk.mat_node[sk.mat[heaviest]], parts.rig_node[a])) arm_of[i] = a;
-  }
+      if (under(rig, heaviest_node(sk, i), parts.rig_node[a])) arm_of[i] = a;
   std::vector<Eigen::Vector3i> others;
   for (Eigen::Index f = 0; f < sk.F.rows(); ++f)
     if (arm_of[sk.F(f, 0)] < 0 && arm_of[sk.F(f, 1)] < 0 && arm_of[sk.F(f, 2)] < 0)
@@ -863,8 +862,10 @@ BodySequence load(const std::string& path, const BodyOptions& opt, bool rest_onl
       seq.arm_turns = clear_arms(clip.rig, surf.sk, to_out, parts, opt, poses);
     }
     seq.frames = skin_frames(clip.rig, surf.sk, to_out, poses, path);
-    if (opt.yield_gap > 0)
+    if (opt.yield_gap > 0) {
       seq.yields = yield_frames(seq.F, seq.rest_V, vertex_segments(clip.rig, surf.sk, path), opt.yield_gap, seq.frames);
+      if (seq.rest_blend_frames > 0) seq.rest_V = seq.frames[0];  // the rest pose is frame 0
+    }
   }
   seq.landmarks = measure_landmarks(TriMesh{seq.rest_V, seq.F}, surf, to_out, clip.skinned, opt.height);
   return seq;
