@@ -134,26 +134,27 @@ BodyYield yield_self_overlap(const Faces& F, Points3& V, const Points3& rest, co
   // and far in the rest pose), or, in between, a neighbouring part's across a joint's crease.
   enum class Whose { Own, Crease, Other };
   const double sep2 = opt.part_separation * opt.part_separation;
+  auto close_at_rest = [&](Eigen::Index i, Eigen::Index j) {
+    return (rest.row(i) - rest.row(j)).squaredNorm() <= sep2;
+  };
+  auto same_part = [&](Eigen::Index i, Eigen::Index j) {
+    return segment.empty() ? close_at_rest(i, j) : segment[i] == segment[j];
+  };
   auto whose = [&](Eigen::Index i, int f) {
     bool near = false;
     for (int c = 0; c < 3; ++c) {
-      const int v = F(f, c);
-      const bool close = (rest.row(v) - rest.row(i)).squaredNorm() <= sep2;
-      if (segment.empty() ? close : segment[v] == segment[i]) return Whose::Own;
-      near = near || close;
+      if (same_part(i, F(f, c))) return Whose::Own;
+      near = near || close_at_rest(i, F(f, c));
     }
     return near ? Whose::Crease : Whose::Other;
-  };
-  auto same_part = [&](Eigen::Index i, Eigen::Index j) {
-    return segment.empty() ? (rest.row(i) - rest.row(j)).squaredNorm() <= sep2 : segment[i] == segment[j];
   };
   BodyYield r;
   const Points3 V0 = V;
   std::vector<char> moved(V.rows(), 0);
+  const double probe = (1 - kGapTolerance) * opt.gap;
   for (int pass = 0; pass < opt.max_passes; ++pass) {
     const BodyQuery q(TriMesh{V, F});
     const Points3 N = unit_vertex_normals(V, F);
-    const double probe = (1 - kGapTolerance) * opt.gap;
     const std::vector<int> w = offset_winding(q, V, N, probe);
     std::vector<Eigen::Index> buried;
     for (Eigen::Index i = 0; i < V.rows(); ++i)
