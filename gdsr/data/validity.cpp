@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <memory>
 #include <set>
 #include <string>
@@ -30,11 +31,30 @@ double median(std::vector<long> v) {
   return n % 2 ? static_cast<double>(v[n / 2]) : 0.5 * static_cast<double>(v[n / 2 - 1] + v[n / 2]);
 }
 
+// The two layers that the most of `pairs` (faces of F) join, inner first; ties go to the lower
+// pair. {-1, -1} without pairs or without layers (layer: per vertex, may be empty).
+std::array<int, 2> commonest_layer_pair(const std::vector<std::pair<int, int>>& pairs, const Faces& F,
+                                        const std::vector<int>& layer) {
+  std::map<std::array<int, 2>, long> count;
+  for (const auto& [f, g] : pairs) {
+    const int a = layer[F(f, 0)], b = layer[F(g, 0)];
+    ++count[{std::min(a, b), std::max(a, b)}];
+  }
+  std::array<int, 2> best = {-1, -1};
+  long most = 0;
+  for (const auto& [key, n] : count)  // in order: the first of equal counts is kept
+    if (n > most) most = n, best = key;
+  return best;
+}
+
 // Self-intersection figures of one resolution over the checked frames (frames in parallel:
 // each CGAL call is independent).
-// Each checked frame's pair count also goes to rows[t].*pairs.
-void measure_intersections(const std::vector<Points3>& frames, const Faces& F, int stride, ResolutionValidity& r,
-                           std::vector<FrameValidity>& rows, long FrameValidity::*pairs_field) {
+// Each checked frame's pair count also goes to rows[t].*pairs, and for a garment of several
+// layers (layer: per vertex) the layers most of its pairs join to rows[t].*layers.
+void measure_intersections(const std::vector<Points3>& frames, const Faces& F, const std::vector<int>& layer,
+                           int stride, ResolutionValidity& r, std::vector<FrameValidity>& rows,
+                           long FrameValidity::*pairs_field, std::array<int, 2> FrameValidity::*layers_field) {
+  const bool layered = !layer.empty() && *std::max_element(layer.begin(), layer.end()) > 0;
   const int T = static_cast<int>(frames.size());
   std::vector<int> checked;
   for (int t = 0; t < T; t += stride) checked.push_back(t);
@@ -43,7 +63,7 @@ void measure_intersections(const std::vector<Points3>& frames, const Faces& F, i
 #pragma omp parallel for schedule(dynamic, 1)
   for (int k = 0; k < static_cast<int>(checked.size()); ++k) {
     try {
-      si[k] = self_intersections(frames[checked[k]], F);
+      si[k] = self_intersections(frames[checked[k]], F, /*list_pairs=*/layered);
     } catch (const std::exception& e) {
 #pragma omp critical(validity_error)
       error = e.what();
@@ -55,6 +75,7 @@ void measure_intersections(const std::vector<Points3>& frames, const Faces& F, i
   for (size_t k = 0; k < checked.size(); ++k) {
     pairs.push_back(si[k].pairs);
     rows[checked[k]].*pairs_field = si[k].pairs;
+    if (layered) rows[checked[k]].*layers_field = commonest_layer_pair(si[k].list, F, layer);
     r.si_clean_frames += si[k].pairs == 0;
     if (si[k].pairs > r.si_max_pairs || r.si_max_frame < 0) {
       r.si_max_pairs = si[k].pairs;
@@ -68,13 +89,18 @@ void measure_intersections(const std::vector<Points3>& frames, const Faces& F, i
 
 // Knots of one resolution (ResolutionValidity::si_knots) from the checked frames' pair counts in
 // rows (-1: not checked); the body's share when `body` (rows[t].body_crossing measured).
-void count_knots(const std::vector<FrameValidity>& rows, long FrameValidity::*pairs_field, bool body,
-                 ResolutionValidity& r) {
+// The longest knot, its first and last frames and where it began (rows[first].*layers), too.
+void count_knots(const std::vector<FrameValidity>& rows, long FrameValidity::*pairs_field,
+                 std::array<int, 2> FrameValidity::*layers_field, bool body, ResolutionValidity& r) {
   r.si_knots = 0;
   r.si_knots_from_body_crossings = body ? 0 : -1;
   r.si_knot_frames_from_body_crossings = body ? 0 : -1;
+  r.si_longest_knot_first = r.si_longest_knot_last = -1;
+  r.si_longest_knot_layers = {-1, -1};
   bool in_knot = false, from_body = false;
-  for (const FrameValidity& f : rows) {
+  int first = -1, length = 0, longest = 0;
+  for (size_t t = 0; t < rows.size(); ++t) {
+    const FrameValidity& f = rows[t];
     const long pairs = f.*pairs_field;
     if (pairs < 0) continue;  // not checked (stride): runs join over it
     if (pairs == 0) {
@@ -86,8 +112,16 @@ void count_knots(const std::vector<FrameValidity>& rows, long FrameValidity::*pa
       ++r.si_knots;
       from_body = body && f.body_crossing;
       r.si_knots_from_body_crossings += from_body;
+      first = static_cast<int>(t);
+      length = 0;
     }
     r.si_knot_frames_from_body_crossings += from_body;
+    if (++length > longest) {
+      longest = length;
+      r.si_longest_knot_first = first;
+      r.si_longest_knot_last = static_cast<int>(t);
+      r.si_longest_knot_layers = rows[first].*layers_field;
+    }
   }
 }
 
@@ -341,11 +375,13 @@ ValidityFigures measure_validity(const Dataset& d, const ValidityOptions& opt, c
   }
   v.lr.torn_vertices = static_cast<int>(lr_torn.size());
   v.hr.torn_vertices = static_cast<int>(hr_torn.size());
-  measure_intersections(d.lr_frames, d.lr.F, opt.intersection_stride, v.lr, v.per_frame, &FrameValidity::lr_pairs);
+  measure_intersections(d.lr_frames, d.lr.F, d.lr.layer, opt.intersection_stride, v.lr, v.per_frame,
+                        &FrameValidity::lr_pairs, &FrameValidity::lr_layers);
   if (progress) progress(T + 1, steps);
-  measure_intersections(d.hr_frames, d.hr.F, opt.intersection_stride, v.hr, v.per_frame, &FrameValidity::hr_pairs);
-  count_knots(v.per_frame, &FrameValidity::lr_pairs, v.body_measured, v.lr);
-  count_knots(v.per_frame, &FrameValidity::hr_pairs, v.body_measured, v.hr);
+  measure_intersections(d.hr_frames, d.hr.F, d.hr.layer, opt.intersection_stride, v.hr, v.per_frame,
+                        &FrameValidity::hr_pairs, &FrameValidity::hr_layers);
+  count_knots(v.per_frame, &FrameValidity::lr_pairs, &FrameValidity::lr_layers, v.body_measured, v.lr);
+  count_knots(v.per_frame, &FrameValidity::hr_pairs, &FrameValidity::hr_layers, v.body_measured, v.hr);
   if (progress) progress(steps, steps);
   return v;
 }
@@ -382,7 +418,11 @@ nlohmann::json resolution_json(const ResolutionValidity& r, bool body) {
                         {"max_pairs_frame", r.si_max_frame},
                         {"degenerate_faces", r.si_degenerate_faces},
                         {"skipped_faces", r.si_skipped_faces},
-                        {"knots", r.si_knots}}},
+                        {"knots", r.si_knots},
+                        {"longest_knot",
+                         {{"first_frame", r.si_longest_knot_first},
+                          {"last_frame", r.si_longest_knot_last},
+                          {"layers", r.si_longest_knot_layers}}}}},
                       {"strain",
                        {{"E_u", r.strain.E_u},
                         {"E_v", r.strain.E_v},
@@ -438,6 +478,12 @@ ResolutionValidity resolution_from_json(const nlohmann::json& j, bool body, cons
       si.contains("knots_from_body_crossings") ? take<int>(si, "knots_from_body_crossings", w) : -1;
   r.si_knot_frames_from_body_crossings =
       si.contains("knot_frames_from_body_crossings") ? take<int>(si, "knot_frames_from_body_crossings", w) : -1;
+  if (si.contains("longest_knot")) {
+    const auto k = take<nlohmann::json>(si, "longest_knot", w);
+    r.si_longest_knot_first = take<int>(k, "first_frame", w + "longest_knot.");
+    r.si_longest_knot_last = take<int>(k, "last_frame", w + "longest_knot.");
+    r.si_longest_knot_layers = take<std::array<int, 2>>(k, "layers", w + "longest_knot.");
+  }
   const auto st = take<nlohmann::json>(j, "strain", where);
   r.strain.E_u = take<double>(st, "E_u", where + "strain.");
   r.strain.E_v = take<double>(st, "E_v", where + "strain.");
@@ -567,6 +613,21 @@ std::string validity_table(const ValidityFigures& v) {
       return std::string(b);
     };
     line("  %-40s %14s %14s\n", "  begun where the body crosses itself", share(v.lr).c_str(), share(v.hr).c_str());
+  }
+  if (v.lr.si_longest_knot_first >= 0 || v.hr.si_longest_knot_first >= 0) {
+    // "47-79, L1-L2": the longest knot's frames and the layers where it began
+    auto knot = [](const ResolutionValidity& r) {
+      if (r.si_longest_knot_first < 0) return std::string("-");
+      char b[64];
+      std::snprintf(b, sizeof b, "%d-%d", r.si_longest_knot_first, r.si_longest_knot_last);
+      std::string s = b;
+      if (r.si_longest_knot_layers[0] >= 0) {
+        std::snprintf(b, sizeof b, ", L%d-L%d", r.si_longest_knot_layers[0], r.si_longest_knot_layers[1]);
+        s += b;
+      }
+      return s;
+    };
+    line("  %-40s %14s %14s\n", "  longest: frames, layers where it began", knot(v.lr).c_str(), knot(v.hr).c_str());
   }
   if (v.lr.si_degenerate_faces + v.hr.si_degenerate_faces + v.lr.si_skipped_faces + v.hr.si_skipped_faces > 0)
     line("  %-40s %6ld / %5ld %6ld / %5ld\n", "  degenerate / non-manifold faces skipped", v.lr.si_degenerate_faces,

@@ -44,6 +44,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <string>
 #include <utility>
 #include <vector>
@@ -82,6 +83,12 @@ struct ResolutionValidity {
   int si_knots = 0;
   int si_knots_from_body_crossings = -1;
   int si_knot_frames_from_body_crossings = -1;
+  // The longest knot (the most checked frames; the first of equals): its first and last checked
+  // frames (-1: no knot, or an older manifest), and the two cloth layers (0 = innermost) that the
+  // most intersecting pairs of its first frame join, where it began: the same layer twice for a
+  // fold through itself; -1 for a garment of one layer.
+  int si_longest_knot_first = -1, si_longest_knot_last = -1;
+  std::array<int, 2> si_longest_knot_layers = {-1, -1};
   // strain, means over frames of the per-frame means over triangles
   StrainEnergies strain;
   double max_edge_stretch = 0;      // longest edge / pattern length, max over frames
@@ -108,6 +115,8 @@ struct ResolutionValidity {
 // One frame's figures (ValidityFigures::per_frame; not stored in the manifest).
 struct FrameValidity {
   long lr_pairs = -1, hr_pairs = -1;  // intersecting triangle pairs (-1: frame not checked, see the stride)
+  // The two cloth layers that most of those pairs join, inner first ({-1, -1}: no pairs, or one layer).
+  std::array<int, 2> lr_layers = {-1, -1}, hr_layers = {-1, -1};
   double lr_depth = 0, hr_depth = 0;  // metres, deepest vertex under the body surface outside pinches (0: none)
   double agreement = 0;               // metres, mean |HR - upsampled LR|
   long lr_threaded = 0, hr_threaded = 0;  // edges of cloth threaded on the body (0 without a body)

@@ -356,6 +356,52 @@ TEST_CASE("gdsr: validity counts knots, runs of frames through itself, and those
   CHECK(gdsr::validity_table(o).find("knots") == std::string::npos);
 }
 
+TEST_CASE("gdsr: validity names the longest knot's frames and the cloth layers where it began") {
+  // The HR sheet of the test above, wrapped 1.25 times round a cylinder (the first fifth of it
+  // under the last) in frames 1, 3, 4 and 6: the longest knot is frames 3-4.
+  gdsr::Dataset d = gdsr_test::stretched_dataset(std::vector<double>(7, 0.001));
+  const Points3 wrapped = gdsr_test::grid_garment(gdsr_test::GridSpec(8, 8, 0.3, 0.3).bent(2.5 * M_PI)).V;
+  for (int t : {1, 3, 4, 6}) d.hr_frames[t] = wrapped;
+  auto longest = [](const gdsr::ResolutionValidity& r) {
+    return std::array<int, 4>{r.si_longest_knot_first, r.si_longest_knot_last, r.si_longest_knot_layers[0],
+                              r.si_longest_knot_layers[1]};
+  };
+  // One layer: frames only. LR has no knot.
+  const gdsr::ValidityFigures one = gdsr::measure_validity(d);
+  CHECK(longest(one.hr) == std::array<int, 4>{3, 4, -1, -1});
+  CHECK(longest(one.lr) == std::array<int, 4>{-1, -1, -1, -1});
+  CHECK(one.per_frame[3].hr_layers == std::array<int, 2>{-1, -1});
+  // Two layers, split down the middle of the sheet (u): the wrapped end (layer 1) lies over the
+  // start (layer 0), so every intersecting pair joins layers 0 and 1.
+  double lo = d.hr.V(0, 0), hi = lo;
+  for (int i = 0; i < d.hr.V.rows(); ++i) lo = std::min(lo, d.hr.V(i, 0)), hi = std::max(hi, d.hr.V(i, 0));
+  const double mid = 0.5 * (lo + hi);
+  d.hr.layer.assign(d.hr.V.rows(), 0);
+  for (int i = 0; i < d.hr.V.rows(); ++i) d.hr.layer[i] = d.hr.V(i, 0) > mid ? 1 : 0;
+  d.lr.layer.assign(d.lr.V.rows(), 0);
+  const gdsr::ValidityFigures two = gdsr::measure_validity(d);
+  CHECK(longest(two.hr) == std::array<int, 4>{3, 4, 0, 1});
+  for (int t : {1, 3, 4, 6}) CHECK(two.per_frame[t].hr_layers == std::array<int, 2>{0, 1});
+  CHECK(two.per_frame[2].hr_layers == std::array<int, 2>{-1, -1});  // no pairs
+  // The whole sheet one outer layer of a layered garment: a fold through itself, layer 2 twice.
+  d.hr.layer.assign(d.hr.V.rows(), 2);
+  CHECK(longest(gdsr::measure_validity(d).hr) == std::array<int, 4>{3, 4, 2, 2});
+  // Every 2nd frame (0, 2, 4, 6): frames 4 and 6 are one run, the longest.
+  gdsr::ValidityOptions opt;
+  opt.intersection_stride = 2;
+  CHECK(longest(gdsr::measure_validity(d, opt).hr) == std::array<int, 4>{4, 6, 2, 2});
+  // Printed, kept by the manifest, absent from older manifests (-1: not measured).
+  CHECK(gdsr::validity_table(two).find("3-4, L0-L1") != std::string::npos);
+  CHECK(gdsr::validity_table(one).find("longest: frames") != std::string::npos);
+  const nlohmann::json j = gdsr::validity_to_json(two);
+  CHECK(longest(gdsr::validity_from_json(j).hr) == std::array<int, 4>{3, 4, 0, 1});
+  nlohmann::json old = j;
+  for (const char* res : {"lr", "hr"}) old[res]["self_intersection"].erase("longest_knot");
+  const gdsr::ValidityFigures o = gdsr::validity_from_json(old);
+  CHECK(longest(o.hr) == std::array<int, 4>{-1, -1, -1, -1});
+  CHECK(gdsr::validity_table(o).find("longest: frames") == std::string::npos);
+}
+
 TEST_CASE("gdsr: validity counts the HR frames that overlap themselves, on every k-th frame") {
   gdsr::Dataset d = gdsr_test::wave_dataset(4);
   // Frame 2: the HR sheet wrapped 1.25 times round a cylinder, so a quarter lies on itself.
