@@ -59,6 +59,17 @@
 #   frames free of self-intersections 76.5 / 75.7% -> 60.3 / 62.5%, inside the spread of the
 #   friction nudged by 1e-5: 62.5 / 75.0% -> 71.3 / 76.5%; 1.2 s more for the body's 136 frames):
 #     bench/sim_sweep.sh build OUT --body-yield-gap "0 0.004" skirt_tiered ../shared/motions/cmu-walk/131_01.bvh 2 4 "--hr-pd 0.03"
+# - self-contact passes on the same kneel (2026-12-07, revision 30). The knot begins between the
+#   middle and outer tiers (data check: "longest: 47-79, L1-L2"): the rising thigh presses the
+#   stack, body contact pushes the inner sheet out and self-contact pushes it back in, every
+#   iteration. 30 mm, friction 0.3 / 0.30001 / 0.30002, frames free of self-intersections LR / HR:
+#   1 pass 76.5 / 75.7, 62.5 / 75.0, 75.7 / 76.5%; 3 passes (0.3) 45.6 / 74.3%; 6 passes 55.9 / 99.3,
+#   99.3 / 97.8, 100 / 76.5% (the 55.9% is a new knot from frame 85, the outer tier through itself,
+#   L2-L2), at 1.6-1.8x the CPU time. 30 / 10 mm at 0.3: 76.5 / 71.3% -> 55.9 / 97.8%, HR 4.6 s a frame
+#   (33k vertices). skirt_tiered on salsa 61_03 (0.3) 100 / 100 -> 98.5 / 100%; dress_layered on
+#   131_01 and 61_03 100 / 100% either way. Not the default: the knot goes in 4 of 6 runs, the cost
+#   is 1.7x, and no setting reaches 99% in every run:
+#     bench/sim_sweep.sh build OUT --self-passes "1 6" skirt_tiered ../shared/motions/cmu-walk/131_01.bvh 2 4 "--hr-pd 0.03"
 set -e
 usage="usage: $0 BUILD_DIR OUT_DIR OPTION VALUES [GARMENT] [MOTION] [START_S] [SECONDS] [FLAGS]"
 build=$(cd "${1:?$usage}" && pwd)
