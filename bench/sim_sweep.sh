@@ -67,8 +67,10 @@
 #   99.3 / 97.8, 100 / 76.5% (the 55.9% is a new knot from frame 85, the outer tier through itself,
 #   L2-L2), at 1.6-1.8x the CPU time. 30 / 10 mm at 0.3: 76.5 / 71.3% -> 55.9 / 97.8%, HR 4.6 s a frame
 #   (33k vertices). skirt_tiered on salsa 61_03 (0.3) 100 / 100 -> 98.5 / 100%; dress_layered on
-#   131_01 and 61_03 100 / 100% either way. Not the default: the knot goes in 4 of 6 runs, the cost
-#   is 1.7x, and no setting reaches 99% in every run:
+#   131_01 and 61_03 100 / 100% either way. skirt_pleated on the same kneel (30 mm, LR, 0.3 /
+#   0.30001 / 0.30002): 1 pass 80.1 / 100 / 100%, 6 passes 100 / 89.7 / 89.7% (its knots begin at
+#   frame 47-48 too). Not the default: the tiers' knot goes in 4 of 6 runs, the cost is 1.7x, and no
+#   setting reaches 99% in every run:
 #     bench/sim_sweep.sh build OUT --self-passes "1 6" skirt_tiered ../shared/motions/cmu-walk/131_01.bvh 2 4 "--hr-pd 0.03"
 set -e
 usage="usage: $0 BUILD_DIR OUT_DIR OPTION VALUES [GARMENT] [MOTION] [START_S] [SECONDS] [FLAGS]"
