@@ -24,10 +24,13 @@
 // pair's faces intersect where they do not is refused, and the pair takes the side it is on.
 //
 // Untangling: edges that already cross a triangle (an intersection that slipped through)
-// mark their and the triangle's vertices "tangled"; pairs touching a tangled vertex, or found
-// deeper on the wrong side than their motion since the detection can explain, get no
-// constraint, and their side follows the geometry, so an intersection is never locked in:
-// stretch and bending pull the layers apart and the pair is guarded again once free.
+// mark their and the triangle's vertices "tangled"; pairs with a tangled vertex on both sides
+// (the vertex and the triangle, or both edges), or found deeper on the wrong side than their
+// motion since the detection can explain, get no constraint, and their side follows the
+// geometry, so an intersection is never locked in: stretch and bending pull the layers apart and
+// the pair is guarded again once free. A pair tangled on one side only is still guarded: a
+// third layer lying on two that crossed is kept on its side of them (freed too, before solver
+// revision 31, it passed through them, and the knot spread through a stack of layers).
 // untangle() also moves them apart actively: each edge still crossing a face is moved against
 // it down the gradient of the intersection contour's length (Volino and Magnenat-Thalmann
 // 2006, "Resolving surface collisions through intersection contour minimization"), so a
@@ -201,6 +204,15 @@ class SelfCollision {
   bool faces_cross(const gdsr::Points3& x, const EE& c) const;
   // True if `push` would make the pair's faces intersect where they do not now; x is left as it was.
   template <class Pair> bool push_makes_crossing(gdsr::Points3& x, const Pair& c, const PairPush& push) const;
+  // A tangled vertex on both sides of the pair: part of an intersection that slipped through (see
+  // "Untangling"), left free.
+  bool tangled_on_both_sides(const VT& c) const {
+    return tangled_[c.v] && (tangled_[F_(c.f, 0)] || tangled_[F_(c.f, 1)] || tangled_[F_(c.f, 2)]);
+  }
+  bool tangled_on_both_sides(const EE& c) const {
+    return (tangled_[edges_[c.a][0]] || tangled_[edges_[c.a][1]]) &&
+           (tangled_[edges_[c.b][0]] || tangled_[edges_[c.b][1]]);
+  }
   bool touches(const VT& c) const { return moved_v_[c.v] | moved_f_[c.f]; }
   bool touches(const EE& c) const { return moved_e_[c.a] | moved_e_[c.b]; }
   void mark_moved(const PairPush& push);

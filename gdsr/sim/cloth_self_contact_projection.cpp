@@ -36,7 +36,7 @@ bool SelfCollision::project_pair(const Points3& x, const ProjectLimits& l, VT& c
   Vec3 bary, n;
   double dist = 0;
   if (!project_on_triangle(p, a, b, cc, bary, n, dist)) return false;
-  const bool free = tangled_[c.v] || tangled_[ia] || tangled_[ib] || tangled_[ic] || -c.side * dist > c.reach;
+  const bool free = tangled_on_both_sides(c) || -c.side * dist > c.reach;
   if (free || bary.minCoeff() < kInside) {  // crossing the plane is legal here: follow the geometry
     if (dist != 0) c.side = dist > 0 ? 1 : -1;
     return false;
@@ -63,7 +63,7 @@ bool SelfCollision::project_pair(const Points3& x, const ProjectLimits& l, EE& c
   const Vec3 d = (p1 + s * (q1 - p1)) - (p2 + t * (q2 - p2));
   const double len = d.norm();
   const Vec3 dir(c.dir[0], c.dir[1], c.dir[2]);
-  const bool free = tangled_[i0] || tangled_[i1] || tangled_[j0] || tangled_[j1] || -d.dot(dir) > c.reach;
+  const bool free = tangled_on_both_sides(c) || -d.dot(dir) > c.reach;
   const bool interior = s > kEdgeEnd && s < 1 - kEdgeEnd && t > kEdgeEnd && t < 1 - kEdgeEnd;
   const double along = d.dot(dir);
   if (free || !interior || dir.squaredNorm() == 0 || (along > 0 && len >= l.thickness)) {
