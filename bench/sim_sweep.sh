@@ -72,6 +72,10 @@
 #   frame 47-48 too). Not the default: the tiers' knot goes in 4 of 6 runs, the cost is 1.7x, and no
 #   setting reaches 99% in every run:
 #     bench/sim_sweep.sh build OUT --self-passes "1 6" skirt_tiered ../shared/motions/cmu-walk/131_01.bvh 2 4 "--hr-pd 0.03"
+#   At revision 31 (pairs freed for untangling only when tangled on both sides), same runs: 1 pass
+#   83.1 / 84.6, 94.1 / 84.6, 77.9 / 86.8%; 6 passes 94.9 / 95.6, 77.2 / 100, 100 / 94.9% (the 77.2% a
+#   knot from frame 50, the inner tier through itself, L0-L0), still 1.7x the CPU time; untangle
+#   step 0.3 (--untangle-step "0.1 0.3") 83.8 / 83.8, 91.2 / 100, 79.4 / 79.4%, at 1.0x.
 set -e
 usage="usage: $0 BUILD_DIR OUT_DIR OPTION VALUES [GARMENT] [MOTION] [START_S] [SECONDS] [FLAGS]"
 build=$(cd "${1:?$usage}" && pwd)
