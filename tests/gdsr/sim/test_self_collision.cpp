@@ -446,7 +446,7 @@ TEST_CASE("self-collision: the detector flags crossing triangles as tangled") {
   CHECK(s1.num_vertex_triangle() == 0);
 }
 
-TEST_CASE("self-collision: a sheet lying on two that cross is kept apart; the crossing pair is left free") {
+TEST_CASE("self-collision: a sheet lying on two that cross is kept apart, and the crossing pair left free") {
   // Sheet a at y = 0 (20 mm), sheet b standing upright through it in the plane x = 1 mm: their
   // edges cross each other's faces along that line, and the vertices there are tangled. Sheet
   // c lies 3 mm above a beside the crossing (x 15-55 mm, 14 mm from b): its pairs with a's
