@@ -243,6 +243,46 @@ namespace sim {
 //     outer tier, now kept out of the middle one, is caught in the left hand at the hip instead
 //     (frames 95-99, up to 31 mm): frames with cloth > 5 mm inside the body outside pinches LR /
 //     HR 21 / 20 -> 29 / 22 at 30 mm, 21 / 18 -> 29 / 23 at 30 / 10 mm.
+//     Where the kneel's knot begins (2026-12-07, revision 31, 30 mm): CMU 131_01 is a slide into
+//     the kneel. From frame 36 to 50 the body's centre travels 60 mm a frame (1.8 m/s) forwards
+//     and 35 cm down, and it stops by frame 50. The tiers overtake the body: at frames 47-48
+//     the fastest cloth moves 145-154 mm a frame while the body moves 72-87, and the tiers are
+//     thrown forwards over the raised thigh. At frame 48, free vertices of every layer are 7-14
+//     mm inside the body where the thigh meets the belly under the front of the waistband, and
+//     a pin of the outer tier is 3 mm inside. The first crossing is a pinned edge of the outer
+//     tier through the middle tier.
+//     More substeps help, so cloth that outruns its thickness within one substep is the likely
+//     cause. --substeps 40 (1.6x the time) gives 96.3 / 76.5, 92.6 / 96.3 and 97.1 / 96.3%, with
+//     knots of 4-10 frames and at most 16-44 pairs, except the HR at 0.3, frames 47-78. Frames
+//     with cloth > 5 mm inside the body outside pinches: 12-14. On the whole 30 mm matrix
+//     (friction 0.3): 23 of 24 clips 100 / 100% free of self-intersections (pants and
+//     skirt_pleated on 131_01 were 89.7% LR); frames with cloth > 5 mm inside the body outside
+//     pinches LR / HR, summed over the 24 clips, 195 / 196 -> 66 / 72 (the t-shirt on 131_01 92 / 92
+//     -> 2 / 1, its sleeve no longer in the elbow's crook; worse: dress_layered on 131_01 12 / 12
+//     -> 18 / 18, skirt_pleated on 131_01 12 / 11 -> 13 / 16), at 1.7x the CPU time.
+//     Substeps set per frame from the cloth's speed at the frame's start, relative to the
+//     cloth's mean (up to 4x): with the 99th percentile kept within 4 mm a substep (21.8
+//     substeps a frame on average), 96.3 / 93.4, 78.7 / 77.9 and 93.4 / 92.6%. With the fastest
+//     vertex kept within 3 mm (37 substeps a frame on average, about --substeps 40's cost),
+//     97.1 / 90.4, 90.4 / 96.3 and 97.8 / 100%. The next step: substeps (or a continuous test)
+//     where the cloth outruns its thickness, measured on the whole matrix for its cost.
+//     Also tried on the kneel, none kept (LR / HR % of frames free of self-intersections at
+//     friction 0.3 / 0.30001 / 0.30002; the onset stayed at frame 46-48 in every run):
+//     - rolling back, at the end of a substep, the free vertices of every edge-face crossing that
+//       was not there at its start (all free vertices after 6 rounds; a knot's own contour may
+//       move on): 64.0 / 63.2% at 0.3. The pinned edge cannot be rolled back, the first crossing
+//       stays, and the cloth rolled back around it is left behind by the body;
+//     - the outer tiers' pins pushed outward by self-contact (up to 15 mm, back at
+//       pin_yield_rate): 77.2 / 77.9, 90.4 / 88.2, 77.2 / 80.1; up to 40 mm at twice the weight
+//       72.8 / 75.0% at 0.3;
+//     - pin_yield_rate for the layered skirt with each pin sharing the press of the innermost
+//       tier's pin beside it (the band pressed as one, so no tier's pin passes another's):
+//       88.2 / 94.9, 80.1 / 79.4, 86.8 / 86.8 (frames with cloth > 5 mm inside the body outside
+//       pinches 15 / 13, 20 / 22, 17 / 16 against 29 / 22, 15 / 15, 21 / 19);
+//     - the tiers 20 mm apart at the waist instead of 12: 72.1 / 75.7% at 0.3;
+//     - the body given way where it crosses itself (data make --body-yield-gap 0.004: the body
+//       crosses itself in 1 frame, not 31): 80.9 / 77.2, 75.0 / 94.9, 79.4 / 78.7%. So the
+//       thigh inside the belly is not what starts the knot.
 inline constexpr int kSolverRevision = 31;
 
 struct SimParams {
