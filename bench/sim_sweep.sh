@@ -76,13 +76,10 @@
 #   83.1 / 84.6, 94.1 / 84.6, 77.9 / 86.8%; 6 passes 94.9 / 95.6, 77.2 / 100, 100 / 94.9% (the 77.2% a
 #   knot from frame 50, the inner tier through itself, L0-L0), still 1.7x the CPU time; untangle
 #   step 0.3 (--untangle-step "0.1 0.3") 83.8 / 83.8, 91.2 / 100, 79.4 / 79.4%, at 1.0x.
-# - substeps on the same kneel (revision 31, 30 mm): the clip is a slide into the kneel, and the
-#   tiers outrun the body as it stops (gdsr/sim/cloth_solver.hpp, revision 31, has the figures).
-#   Friction 0.3 / 0.30001 / 0.30002, LR / HR % free of self-intersections: 20 substeps 83.1 /
-#   84.6, 94.1 / 84.6, 77.9 / 86.8%; 40 substeps 96.3 / 76.5, 92.6 / 96.3, 97.1 / 96.3%, at 1.6x the
-#   wall time. Frames with cloth > 5 mm inside the body outside pinches: 29 / 22, 15 / 15, 21 / 19
-#   -> 12 / 13, 12 / 12, 12 / 14. On the whole 30 mm matrix at 40 substeps (0.3): 23 of 24 clips
-#   100 / 100% free of self-intersections, body frames summed 195 / 196 -> 66 / 72, 1.7x the CPU:
+# - substeps on the same kneel (revision 31, 30 mm): the clip is a slide into the kneel and the
+#   tiers outrun their thickness within a substep as the body stops; 40 substeps clear most of
+#   its knots at 1.7x the CPU (the figures, and the whole matrix's, are in the revision-31 entry
+#   of gdsr/sim/cloth_solver.hpp):
 #     bench/sim_sweep.sh build OUT --substeps "20 40" skirt_tiered ../shared/motions/cmu-walk/131_01.bvh 2 4 "--hr-pd 0.03"
 set -e
 usage="usage: $0 BUILD_DIR OUT_DIR OPTION VALUES [GARMENT] [MOTION] [START_S] [SECONDS] [FLAGS]"
