@@ -5,7 +5,7 @@
 // substeps between detections; thick: the self-contact thickness; contact_every: substeps
 // between body contact refreshes; redetect: only the pairs of a vertex that left its slack are
 // found again, or all; retest: the tangle test also after a substep that pushed pairs back
-// across, or once a frame), with and without
+// across, or once a frame; travel: adaptive substeps, SimParams::substep_travel, 0: fixed), with and without
 // self-collision. Every setting starts from
 // the drape `gdsr data make` starts its clip from (the first pose's settle with the default
 // solver, HR from the upsampled LR drape), so the figures are those of a dataset, and the
@@ -95,8 +95,10 @@ const gdsr::Points3& start(int mm) {
 // solver before revision 8); thickness_m > 0: that self-contact thickness; 0: the solver's defaults.
 std::vector<gdsr::Points3> run(int mm, int substeps, int iterations, bool self_collision, double slack_m = 0,
                                int detect_every = 0, double thickness_m = 0, int contact_every = 0,
-                               bool redetect = true, bool retest = false) {
+                               bool redetect = true, bool retest = false, double travel_m = 0,
+                               double* substeps_per_frame = nullptr) {
   sim::SimParams p;
+  p.substep_travel = travel_m;  // 0: `substeps` every frame
   p.self_redetect = redetect;
   p.self_tangle_retest = retest;
   p.substeps = substeps;
@@ -110,7 +112,8 @@ std::vector<gdsr::Points3> run(int mm, int substeps, int iterations, bool self_c
   if (thickness_m > 0) p.self_thickness = thickness_m;
   if (contact_every > 0) p.contact_every = contact_every;
   p.settle_frames = 0;  // from the settled drape
-  return sim::simulate_frames(garment(mm), scene().F, scene().frames, scene().fps, p, {}, &start(mm));
+  return sim::simulate_frames(garment(mm), scene().F, scene().frames, scene().fps, p, {}, &start(mm), nullptr,
+                              substeps_per_frame);
 }
 
 const gdsr::Points3& reference(int mm) {
@@ -131,16 +134,17 @@ void BM_ClothSkirtShort(benchmark::State& state) {
   const int contact_every = static_cast<int>(state.range(7));  // 0: the solver's
   const bool redetect = state.range(8) != 0;
   const bool retest = state.range(9) != 0;
+  const double travel = state.range(10) * 1e-4;  // 0.1 mm units; 0: fixed substeps
   const auto& sc = scene();
   const auto& g = garment(mm);
   const auto& ref = reference(mm);
   std::vector<gdsr::Points3> out;
-  double seconds = 0, cpu = 0;
+  double seconds = 0, cpu = 0, substeps_per_frame = 0;
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::clock_t c0 = std::clock();
-    out =
-        run(mm, substeps, iterations, self_collision, slack, detect_every, thickness, contact_every, redetect, retest);
+    out = run(mm, substeps, iterations, self_collision, slack, detect_every, thickness, contact_every, redetect, retest,
+              travel, &substeps_per_frame);
     cpu += static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
@@ -153,6 +157,7 @@ void BM_ClothSkirtShort(benchmark::State& state) {
     pen = std::max(pen, f.penetration.max_depth);
   }
   state.counters["verts"] = static_cast<double>(g.mesh.V.rows());
+  state.counters["substeps_per_frame"] = substeps_per_frame;
   // Wall time and process CPU time (the solver is single-threaded, so CPU time is its cost
   // on an idle core even when the machine is loaded).
   state.counters["s_per_frame"] = seconds / state.iterations() / (sc.frames.size() - 1);
@@ -178,19 +183,24 @@ void BM_ClothSkirtShort(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_ClothSkirtShort)
-    ->Args({30, 40, 1, 0, 0, 0, 0, 0, 1, 0})  // the former default: no self-collision, one pass
-    ->Args({30, 20, 2, 1, 0, 0, 0, 0, 1, 0})  // the default
-    ->Args({30, 10, 2, 1, 0, 0, 0, 0, 1, 0})
-    ->Args({30, 20, 4, 1, 0, 0, 0, 0, 1, 0})
-    ->Args({10, 40, 1, 0, 0, 0, 0, 0, 1, 0})
-    // The default: slack 1.5 mm, detected at most every 8 substeps, 5 mm thick.
-    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 1, 0})
-    ->Args({10, 10, 2, 1, 0, 0, 0, 0, 1, 0})
+    ->Args({30, 40, 1, 0, 0, 0, 0, 0, 1, 0, 0})  // the former default: no self-collision, one pass
+    // The default: at least 20 substeps, more where the fastest vertex would move > 3 mm in one
+    // (SimParams::substep_travel); then 20 fixed, the default before solver revision 32.
+    ->Args({30, 20, 2, 1, 0, 0, 0, 0, 1, 0, 30})
+    ->Args({30, 20, 2, 1, 0, 0, 0, 0, 1, 0, 0})
+    ->Args({30, 10, 2, 1, 0, 0, 0, 0, 1, 0, 0})
+    ->Args({30, 20, 4, 1, 0, 0, 0, 0, 1, 0, 0})
+    ->Args({10, 40, 1, 0, 0, 0, 0, 0, 1, 0, 0})
+    // The default: slack 1.5 mm, detected at most every 8 substeps, 5 mm thick, adaptive
+    // substeps; then 20 fixed.
+    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 1, 0, 30})
+    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 1, 0, 0})
+    ->Args({10, 10, 2, 1, 0, 0, 0, 0, 1, 0, 0})
     // The 10 mm default before solver revision 8: the 30 mm mesh's 3 mm slack, detected at most
     // every 4 substeps. The same figures in 1.7x the time (SimParams::self_slack_per_pd).
-    ->Args({10, 20, 2, 1, 30, 4, 0, 0, 1, 0})
+    ->Args({10, 20, 2, 1, 30, 4, 0, 0, 1, 0, 0})
     // The 10 mm default before solver revision 18: 3 mm thick (SimParams::self_thickness).
-    ->Args({10, 20, 2, 1, 0, 0, 30, 0, 1, 0})
+    ->Args({10, 20, 2, 1, 0, 0, 30, 0, 1, 0, 0})
     // Body contacts found every substep instead of every 5th (SimParams::contact_every): a fast
     // limb cannot overtake the cloth between two refreshes. On this walk: 1.8x (30 mm) and 1.4x
     // (10 mm) the CPU time for the same figures (no penetration either way, RMS from the
@@ -198,20 +208,20 @@ BENCHMARK(BM_ClothSkirtShort)
     // the t-shirt's (sim::body_contact_every, for its sleeves in a bending elbow's crook); on this
     // walk 1.07x the CPU time at both 30 mm (0.050 s a frame) and 10 mm (0.66 s), the same figures
     // (RMS from the reference 15.9 and 28.8 mm, every 4th frame free of self-intersections).
-    ->Args({30, 20, 2, 1, 0, 0, 0, 1, 1, 0})
-    ->Args({10, 20, 2, 1, 0, 0, 0, 1, 1, 0})
-    ->Args({30, 20, 2, 1, 0, 0, 0, 3, 1, 0})
-    ->Args({10, 20, 2, 1, 0, 0, 0, 3, 1, 0})
+    ->Args({30, 20, 2, 1, 0, 0, 0, 1, 1, 0, 0})
+    ->Args({10, 20, 2, 1, 0, 0, 0, 1, 1, 0, 0})
+    ->Args({30, 20, 2, 1, 0, 0, 0, 3, 1, 0, 0})
+    ->Args({10, 20, 2, 1, 0, 0, 0, 3, 1, 0, 0})
     // A full detection whenever a vertex leaves its slack, as before solver revision 22, instead
     // of finding only its pairs again (SimParams::self_redetect).
-    ->Args({30, 20, 2, 1, 0, 0, 0, 0, 0, 0})
-    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 0, 0})
+    ->Args({30, 20, 2, 1, 0, 0, 0, 0, 0, 0, 0})
+    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 0, 0, 0})
     // The tangle test also after a substep that pushed pairs back across, not only once a frame
     // (SimParams::self_tangle_retest, off by default).
-    ->Args({30, 20, 2, 1, 0, 0, 0, 0, 1, 1})
-    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 1, 1})
+    ->Args({30, 20, 2, 1, 0, 0, 0, 0, 1, 1, 0})
+    ->Args({10, 20, 2, 1, 0, 0, 0, 0, 1, 1, 0})
     ->ArgNames({"mm", "substeps", "iterations", "self", "slack_0.1mm", "detect", "thick_0.1mm", "contact_every",
-                "redetect", "retest"})
+                "redetect", "retest", "travel_0.1mm"})
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
 

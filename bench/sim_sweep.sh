@@ -81,6 +81,9 @@
 #   its knots at 1.7x the CPU (the figures, and the whole matrix's, are in the revision-31 entry
 #   of gdsr/sim/cloth_solver.hpp):
 #     bench/sim_sweep.sh build OUT --substeps "20 40" skirt_tiered ../shared/motions/cmu-walk/131_01.bvh 2 4 "--hr-pd 0.03"
+# - adaptive substeps (revision 32's default, 3 mm; 0: 20 fixed): the table's speed column has
+#   the substeps a frame took; the 30 mm matrix and the 10 mm runs are in the revision-32 entry:
+#     bench/sim_sweep.sh build OUT --substep-travel "0 0.003" skirt_pleated ../shared/motions/cmu-walk/131_01.bvh
 set -e
 usage="usage: $0 BUILD_DIR OUT_DIR OPTION VALUES [GARMENT] [MOTION] [START_S] [SECONDS] [FLAGS]"
 build=$(cd "${1:?$usage}" && pwd)

@@ -28,6 +28,9 @@ def row(name, res, v, stats):
     cpu = stats.get(f"{res}_cpu_seconds_per_frame")
     wall = stats.get(f"{res}_seconds_per_frame")
     speed = f"{wall:.3f} / {cpu:.3f}" if wall is not None and cpu is not None else "-"
+    substeps = stats.get(f"{res}_substeps_per_frame")  # manifests before solver revision 32 have none
+    if substeps is not None:
+        speed += f" ({substeps:.1f} substeps)"
     agree = v["agreement_m"]
     agreement = f'{1000 * agree["mean"]:.1f} / {1000 * agree["max_frame_mean"]:.1f}' if res == "hr" else ""
     if res == "hr" and "lr_scale_mean" in agree:  # manifests from before the split by scale have none
@@ -41,7 +44,7 @@ def row(name, res, v, stats):
 def main(dirs):
     print("| dataset | res | faces | clean frames (CGAL) | pairs median / max | E_u | E_v | E_uv "
           "| max penetration mm (frames > 5 mm): all / outside pinches / pinch frames | HR-LR agreement mm mean / worst frame (drape, wrinkles) "
-          "| mean curvature 1/m | s/frame wall / CPU |")
+          "| mean curvature 1/m | s/frame wall / CPU (substeps per frame) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     status = 0
     for d in dirs:

@@ -74,6 +74,8 @@ struct MakeArgs {
   double self_slack_per_pd = NAN, untangle_step = NAN, max_push_step = NAN, pinch_separation = NAN,
          dressed_radius = NAN;
   double contact_travel = NAN;
+  double substep_travel = NAN;  // metres (sim::SimParams::substep_travel)
+  int max_substeps = -1;
   double arm_clearance = 0.01;  // metres, gdsr::BodyOptions::arm_clearance (0: the motion as in the file)
   double min_shoulder_half_width = gdsr::BodyOptions{}.min_shoulder_half_width;  // metres (0: as in the file)
   double body_yield_gap = 0;  // metres, gdsr::BodyOptions::yield_gap (0: the skinned surface as it is)
@@ -112,6 +114,11 @@ double effective_track_rate(const MakeArgs& a) {
   return std::isnan(a.track_rate) ? sim::SimParams().track_rate : a.track_rate;
 }
 
+// The largest move of a vertex per substep in effect, metres (--substep-travel, else the solver's).
+double effective_substep_travel(const MakeArgs& a) {
+  return std::isnan(a.substep_travel) ? sim::SimParams().substep_travel : a.substep_travel;
+}
+
 // Substeps between body contact refreshes in effect (--contact-every, else the garment's).
 int effective_contact_every(const MakeArgs& a) {
   return a.contact_every > 0 ? a.contact_every : sim::body_contact_every(a.garment, sim::SimParams().contact_every);
@@ -122,6 +129,7 @@ struct SimRun {
   std::vector<gdsr::Points3> frames;
   double seconds_per_frame = 0;      // wall clock
   double cpu_seconds_per_frame = 0;  // process CPU time
+  double substeps_per_frame = 0;     // mean, settle included (sim::SimParams::substep_travel)
 };
 
 SimRun simulate_one(sim::Garment garment, const char* label, const gdsr::BodySequence& body,
@@ -132,7 +140,7 @@ SimRun simulate_one(sim::Garment garment, const char* label, const gdsr::BodySeq
   gdsr::ProgressBar bar(std::string("simulate ") + label + " (" + std::to_string(r.garment.mesh.V.rows()) +
                         " vertices)");
   const double t0 = now_seconds(), c0 = cpu_seconds();
-  r.frames = sim::simulate(r.garment, body, params, bar.callback(), start, guide);
+  r.frames = sim::simulate(r.garment, body, params, bar.callback(), start, guide, &r.substeps_per_frame);
   bar.finish();
   const double steps = static_cast<double>(std::max<size_t>(1, r.frames.size() + params.settle_frames));
   r.seconds_per_frame = (now_seconds() - t0) / steps;
@@ -182,6 +190,11 @@ void run_make(const MakeArgs& a) {
   if (!(a.hr_pd <= a.lr_pd))
     gdsr::fail("--hr-pd", "the HR particle distance " + std::to_string(a.hr_pd) +
                               " m is coarser than the LR one (--lr-pd " + std::to_string(a.lr_pd) + " m)");
+  const sim::SimParams defaults;
+  const int least = a.substeps > 0 ? a.substeps : defaults.substeps,
+            most = a.max_substeps > 0 ? a.max_substeps : defaults.max_substeps;
+  if (effective_substep_travel(a) > 0 && most < least)
+    gdsr::fail("--max-substeps", std::to_string(most) + " is fewer than --substeps " + std::to_string(least));
   gdsr::BodyOptions bo;
   bo.fps = a.fps;
   bo.rest_blend_frames = a.rest_blend_frames;
@@ -224,6 +237,8 @@ void run_make(const MakeArgs& a) {
 
   sim::SimParams params;
   if (a.substeps > 0) params.substeps = a.substeps;
+  params.substep_travel = effective_substep_travel(a);
+  if (a.max_substeps > 0) params.max_substeps = a.max_substeps;
   if (a.iterations > 0) params.iterations = a.iterations;
   if (a.stretch_passes > 0) params.stretch_passes = a.stretch_passes;
   if (a.settle_frames >= 0) params.settle_frames = a.settle_frames;
@@ -282,6 +297,8 @@ void run_make(const MakeArgs& a) {
   m.sim_params = {{"solver", "xpbd"},
                   {"solver_revision", sim::kSolverRevision},
                   {"substeps", params.substeps},
+                  {"substep_travel_m", params.substep_travel},
+                  {"max_substeps", params.max_substeps},
                   {"iterations", params.iterations},
                   {"stretch_passes", params.stretch_passes},
                   {"thickness_m", params.thickness},
@@ -350,6 +367,8 @@ void run_make(const MakeArgs& a) {
              {"hr_seconds_per_frame", hr.seconds_per_frame},
              {"lr_cpu_seconds_per_frame", lr.cpu_seconds_per_frame},
              {"hr_cpu_seconds_per_frame", hr.cpu_seconds_per_frame},
+             {"lr_substeps_per_frame", lr.substeps_per_frame},
+             {"hr_substeps_per_frame", hr.substeps_per_frame},
              {"lr_max_kinetic_energy_j", lr_ke},
              {"hr_max_kinetic_energy_j", hr_ke}};
   gdsr::write_dataset(a.out, d);
@@ -359,10 +378,10 @@ void run_make(const MakeArgs& a) {
   std::printf("  vertices: LR %d (pd %.3g m), HR %d (pd %.3g m), %.1fx; body %d\n", m.lr_vertices, a.lr_pd,
               m.hr_vertices, a.hr_pd, static_cast<double>(m.hr_vertices) / m.lr_vertices, m.body_vertices);
   std::printf(
-      "  seconds per frame (substeps %d): LR %.4f, HR %.4f wall; LR %.4f, HR %.4f CPU; correspondences + raster %.2f "
-      "s\n",
-      params.substeps, lr.seconds_per_frame, hr.seconds_per_frame, lr.cpu_seconds_per_frame, hr.cpu_seconds_per_frame,
-      corr_seconds);
+      "  seconds per frame (substeps per frame LR %.1f, HR %.1f): LR %.4f, HR %.4f wall; LR %.4f, HR %.4f CPU; "
+      "correspondences + raster %.2f s\n",
+      lr.substeps_per_frame, hr.substeps_per_frame, lr.seconds_per_frame, hr.seconds_per_frame,
+      lr.cpu_seconds_per_frame, hr.cpu_seconds_per_frame, corr_seconds);
   std::printf("  max kinetic energy: LR %.4f J, HR %.4f J\n", lr_ke, hr_ke);
   std::printf("%s", gdsr::validity_table(v).c_str());
   std::printf("  (validity figures: %.1f s)\n", validity_seconds);
@@ -404,6 +423,12 @@ bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why
     if (!same(built_limit, a.min_shoulder_half_width) &&
         !(sp.value("captured_shoulder_half_width_m", 0.0) >= std::max(built_limit, a.min_shoulder_half_width))) {
       why = "built with another shoulder width limit";
+      return false;
+    }
+    if (!same(sp.value("substep_travel_m", 0.0), effective_substep_travel(a)) ||
+        (effective_substep_travel(a) > 0 &&
+         sp.value("max_substeps", 0) != (a.max_substeps > 0 ? a.max_substeps : sim::SimParams().max_substeps))) {
+      why = "built with other adaptive substeps";
       return false;
     }
     if (sp.value("contact_every", 0) != effective_contact_every(a)) {
@@ -951,6 +976,13 @@ void add_data_command(CLI::App& app) {
   make->add_option("--start", mk->start, "clip start in seconds")->capture_default_str()->check(finite_range(0.0, 1e6));
   make->add_option("--fps", mk->fps, "frames per second")->capture_default_str()->check(finite_range(1.0, kMaxFps));
   make->add_option("--substeps", mk->substeps, "solver substeps per frame (default: the solver's)")
+      ->check(CLI::Range(1, 1000));
+  make->add_option("--substep-travel", mk->substep_travel,
+                   "metres: a frame takes more substeps (up to --max-substeps) when its fastest vertex would move "
+                   "farther than this in one, relative to the cloth's mean; 0: always --substeps (default: the "
+                   "solver's, sim::SimParams::substep_travel)")
+      ->check(finite_range(0.0, 1.0));
+  make->add_option("--max-substeps", mk->max_substeps, "most substeps a frame takes with --substep-travel")
       ->check(CLI::Range(1, 1000));
   make->add_option("--iterations", mk->iterations, "constraint passes per substep (default: the solver's)")
       ->check(CLI::Range(1, 100));

@@ -4,6 +4,8 @@
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <map>
+#include <memory>
 #include <omp.h>
 
 namespace sim {
@@ -13,8 +15,9 @@ struct ImplicitBending::Impl {
   std::vector<int> free_vertex;  // row -> vertex
   std::vector<double> mass;      // per free row, kg
   Eigen::SparseMatrix<double> Q_ff, Q_fp;  // bending Hessian blocks: free x free, free x all vertices (fixed cols only)
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
-  double h = 0;  // substep the factorisation is for
+  using Factor = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>;
+  // One per substep length h seen (SimParams::substep_travel varies it between frames).
+  std::map<double, std::unique_ptr<Factor>> factors;
 };
 
 ImplicitBending::ImplicitBending(int nv, const std::vector<BendStencil>& bends, const std::vector<double>& mass,
@@ -101,13 +104,14 @@ void ImplicitBending::solve(double h, gdsr::Points3& x) {
   auto& I = *impl_;
   const int nf = static_cast<int>(I.free_vertex.size());
   if (nf == 0) return;
-  if (h != I.h) {
+  std::unique_ptr<Impl::Factor>& factor = I.factors[h];
+  if (!factor) {
     Eigen::SparseMatrix<double> S = (h * h) * I.Q_ff;
     for (int r = 0; r < nf; ++r) S.coeffRef(r, r) += I.mass[r];
-    I.ldlt.compute(S);
-    if (I.ldlt.info() != Eigen::Success) gdsr::fail("sim/cloth_bending_solve", "factorisation failed");
-    I.h = h;
+    factor = std::make_unique<Impl::Factor>(S);
+    if (factor->info() != Eigen::Success) gdsr::fail("sim/cloth_bending_solve", "factorisation failed");
   }
+  const Impl::Factor& ldlt = *factor;
   Eigen::MatrixXd rhs(nf, 3);
   for (int r = 0; r < nf; ++r) rhs.row(r) = I.mass[r] * x.row(I.free_vertex[r]);
   if (I.Q_fp.nonZeros() > 0) rhs -= (h * h) * (I.Q_fp * Eigen::MatrixXd(x));
@@ -120,10 +124,10 @@ void ImplicitBending::solve(double h, gdsr::Points3& x) {
   // t-shirt (bench/bench_gauss_seidel.cpp): Eigen's solve, a column at a time, 14.4 ms for the
   // three on one thread; these sweeps 7.8 ms on one thread, 6.5 ms on two.
   constexpr int kParallelRows = 4096;
-  const auto& L = I.ldlt.matrixL().nestedExpression();  // unit lower, column-major, strictly below the diagonal
+  const auto& L = ldlt.matrixL().nestedExpression();  // unit lower, column-major, strictly below the diagonal
   RowPoints sol(nf, 3);
-  sol = I.ldlt.permutationP() * rhs;
-  const Eigen::VectorXd inv_d = I.ldlt.vectorD().cwiseInverse();
+  sol = ldlt.permutationP() * rhs;
+  const Eigen::VectorXd inv_d = ldlt.vectorD().cwiseInverse();
   auto solve = [&](int c0, int k) {
     if (k == 3) substitute<3>(L, inv_d, sol, c0);
     if (k == 2) substitute<2>(L, inv_d, sol, c0);
@@ -138,7 +142,7 @@ void ImplicitBending::solve(double h, gdsr::Points3& x) {
     else
       solve(2, 1);
   }
-  sol = I.ldlt.permutationPinv() * sol;
+  sol = ldlt.permutationPinv() * sol;
   for (int r = 0; r < nf; ++r) x.row(I.free_vertex[r]) = sol.row(r);
 }
 

@@ -8,9 +8,9 @@
 // same fabric at 30 mm (a cantilever at 10 mm hung almost vertically where the heavy
 // elastica says 42 degrees). The backward-Euler step of inertia plus this energy,
 //   (M + h^2 Q) x = M y,      y = the predicted positions,
-// is exact for the bending part at any resolution, and its matrix is constant, so it is
-// factored once (sparse LDL^T) and each substep costs one forward/back substitution for
-// the three coordinates. Fixed (pinned) vertices keep their positions and enter the
+// is exact for the bending part at any resolution, and its matrix is constant for a substep
+// length h, so it is factored once per h (sparse LDL^T) and each substep costs one
+// forward/back substitution for the three coordinates. Fixed (pinned) vertices keep their positions and enter the
 // right-hand side. Deterministic (sequential factorisation and solves).
 #pragma once
 
@@ -38,7 +38,7 @@ class ImplicitBending {
 
   // x: predicted positions of the free vertices and current positions of the fixed ones
   // (metres); replaces the free rows by the solution of (M + h^2 Q) x = M y for a substep of
-  // h seconds. The factorisation is computed on the first call and again when h changes.
+  // h seconds. A factorisation is computed on the first call with each h and kept.
   void solve(double h, gdsr::Points3& x);
 
  private:

@@ -80,6 +80,10 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
   if (m.FUV.rows() != m.F.rows()) gdsr::fail("sim/cloth_solver", "garment F and FUV differ in face count");
   if (p.substeps < 1 || p.iterations < 1 || p.contact_every < 1 || p.stretch_passes < 1)
     gdsr::fail("sim/cloth_solver", "substeps, iterations, stretch_passes and contact_every must be >= 1");
+  if (!(p.substep_travel >= 0) || !std::isfinite(p.substep_travel))
+    gdsr::fail("sim/cloth_solver", "substep_travel must be finite and >= 0");
+  if (p.substep_travel > 0 && p.max_substeps < p.substeps)
+    gdsr::fail("sim/cloth_solver", "max_substeps must be >= substeps");
   if (!(p.contact_travel >= 0) || !std::isfinite(p.contact_travel))
     gdsr::fail("sim/cloth_solver", "contact_travel must be finite and >= 0");
   if (!(p.pin_yield_rate >= 0) || !std::isfinite(p.pin_yield_rate))
@@ -803,12 +807,27 @@ void ClothSolver::track_guide(double a0, double dt, double h) {
   pull_step_ = x_ - before;
 }
 
+int ClothSolver::substeps_for(double dt) const {
+  const int n = p_.substeps;
+  if (!(p_.substep_travel > 0) || x_.rows() == 0) return n;
+  const Eigen::RowVector3d mean_v = v_.colwise().mean();
+  double fastest = 0;  // m/s, relative to the mean
+  for (Eigen::Index v = 0; v < v_.rows(); ++v) fastest = std::max(fastest, (v_.row(v) - mean_v).norm());
+  const double wanted = std::ceil(fastest * dt / p_.substep_travel);
+  if (!(wanted > n)) return n;  // NaN velocities fail after the step
+  // Multiples of a quarter of `substeps`: the implicit bending solve keeps a factorisation per substep length.
+  const int quantum = std::max(1, n / 4);
+  const double steps = std::ceil((wanted - n) / quantum);
+  return std::min(p_.max_substeps, n + static_cast<int>(std::min<double>(steps, p_.max_substeps)) * quantum);
+}
+
 void ClothSolver::step(const Points3& body_from, const Points3& body_to, double dt) {
   if (!(dt > 0)) gdsr::fail("sim/cloth_solver", "frame time must be positive");
   const bool has_body = bodyF_.rows() > 0;
   if (has_body && (body_from.rows() != body_to.rows() || body_from.rows() <= bodyF_.maxCoeff()))
     gdsr::fail("sim/cloth_solver", "body pose vertex count does not match the body faces");
-  const int n = p_.substeps;
+  const int n = substeps_for(dt);
+  num_substeps_ += n;
   const double h = dt / n;
   const double h2 = h * h;
   if (has_body) grid_.build(bodyF_, body_from, body_to, body_cell_);
@@ -857,7 +876,7 @@ void ClothSolver::step(const Points3& body_from, const Points3& body_to, double 
 
 std::vector<Points3> simulate_frames(const Garment& g, const gdsr::Faces& body_F, const std::vector<Points3>& frames,
                                      double fps, const SimParams& p, const gdsr::ProgressFn& progress,
-                                     const Points3* start, const Guide* guide) {
+                                     const Points3* start, const Guide* guide, double* substeps_per_frame) {
   if (frames.empty()) gdsr::fail("sim/cloth_solver", "no body frames");
   if (guide && guide->frames.size() != frames.size())
     gdsr::fail("sim/cloth_solver", "the guide has " + std::to_string(guide->frames.size()) + " frames for " +
@@ -900,6 +919,8 @@ std::vector<Points3> simulate_frames(const Garment& g, const gdsr::Faces& body_F
     out.push_back(solver.positions());
     if (progress) progress(++done, total);
   }
+  const int steps = total - 1;  // frame 0 is the settle's end
+  if (substeps_per_frame) *substeps_per_frame = steps > 0 ? static_cast<double>(solver.num_substeps()) / steps : 0;
   return out;
 }
 

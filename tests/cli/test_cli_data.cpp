@@ -9,6 +9,7 @@
 #include "tests/support/data_fixtures.hpp"
 
 #include <doctest/doctest.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "gdsr/sim/cloth_solver.hpp"
@@ -488,6 +489,24 @@ TEST_CASE("cli data: --skip-built keeps a clip built by this solver revision and
   REQUIRE(refusing.status == 0);
   CHECK(refusing.out.find("built with another rule for pushes back across") != std::string::npos);
   CHECK(gdsr_test::slurp(out + "/manifest.json").find("\"self_refuse_crossing_push\": true") != std::string::npos);
+  // And the adaptive substeps (SimParams::substep_travel), whose mean per frame is in the stats.
+  const std::string refusing_cmd = as_before + " --tangle-retest --refuse-crossing-push";
+  const Run adaptive = gdsr_run(dir, refusing_cmd + " --substep-travel 0.0001 --max-substeps 35");
+  REQUIRE(adaptive.status == 0);
+  CHECK(adaptive.out.find("built with other adaptive substeps") != std::string::npos);
+  const nlohmann::json m = nlohmann::json::parse(gdsr_test::slurp(out + "/manifest.json"));
+  CHECK(m["sim_params"]["substep_travel_m"].get<double>() == 0.0001);
+  CHECK(m["sim_params"]["max_substeps"].get<int>() == 35);
+  const double lr_substeps = m["stats"]["lr_substeps_per_frame"].get<double>();
+  // The hem of a settling skirt falls faster than 0.1 mm in 1/600 s relative to the waist.
+  CHECK(lr_substeps > m["sim_params"]["substeps"].get<int>());
+  CHECK(lr_substeps <= 35);
+  CHECK(gdsr_run(dir, refusing_cmd + " --substep-travel 0.0001 --max-substeps 35").out.find("kept") !=
+        std::string::npos);
+  CHECK(gdsr_run(dir, refusing_cmd + " --substep-travel 0.0001 --max-substeps 40")
+            .out.find("built with other adaptive") != std::string::npos);
+  check_one_line_error(gdsr_run(dir, refusing_cmd + " --substep-travel 0.003 --max-substeps 10"),
+                       "--max-substeps: 10 is fewer than --substeps 20");
 }
 
 TEST_CASE("cli data: the t-shirt is simulated with its own body contact refresh, every 3rd substep") {

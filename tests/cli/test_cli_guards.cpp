@@ -80,7 +80,8 @@ TEST_CASE("cli guards: data make refuses bad numbers before simulating") {
   TempDir dir("guard_numbers");
   for (const std::string bad :
        {"--raster 0", "--raster 100000", "--seconds -1", "--seconds nan", "--substeps -3", "--fps 100000", "--fps 0",
-        "--fps nan", "--hr-pd 1e-4", "--lr-pd inf", "--rest-blend -1", "--friction nan"}) {
+        "--fps nan", "--hr-pd 1e-4", "--lr-pd inf", "--rest-blend -1", "--friction nan", "--substep-travel -1",
+        "--substep-travel nan", "--max-substeps 0", "--max-substeps 10"}) {
     const Run r = gdsr_run(dir, "data make --out '" + (dir / "bad") + "' " + bad);
     check_one_line_error(r, bad.substr(0, bad.find(' ')));
     CHECK(r.out.find("body:") == std::string::npos);
