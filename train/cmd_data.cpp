@@ -119,6 +119,11 @@ double effective_substep_travel(const MakeArgs& a) {
   return std::isnan(a.substep_travel) ? sim::SimParams().substep_travel : a.substep_travel;
 }
 
+// The most substeps a frame may take in effect (--max-substeps, else the solver's).
+int effective_max_substeps(const MakeArgs& a) {
+  return a.max_substeps > 0 ? a.max_substeps : sim::SimParams().max_substeps;
+}
+
 // Substeps between body contact refreshes in effect (--contact-every, else the garment's).
 int effective_contact_every(const MakeArgs& a) {
   return a.contact_every > 0 ? a.contact_every : sim::body_contact_every(a.garment, sim::SimParams().contact_every);
@@ -190,11 +195,10 @@ void run_make(const MakeArgs& a) {
   if (!(a.hr_pd <= a.lr_pd))
     gdsr::fail("--hr-pd", "the HR particle distance " + std::to_string(a.hr_pd) +
                               " m is coarser than the LR one (--lr-pd " + std::to_string(a.lr_pd) + " m)");
-  const sim::SimParams defaults;
-  const int least = a.substeps > 0 ? a.substeps : defaults.substeps,
-            most = a.max_substeps > 0 ? a.max_substeps : defaults.max_substeps;
-  if (effective_substep_travel(a) > 0 && most < least)
-    gdsr::fail("--max-substeps", std::to_string(most) + " is fewer than --substeps " + std::to_string(least));
+  const int least = a.substeps > 0 ? a.substeps : sim::SimParams().substeps;
+  if (effective_substep_travel(a) > 0 && effective_max_substeps(a) < least)
+    gdsr::fail("--max-substeps",
+               std::to_string(effective_max_substeps(a)) + " is fewer than --substeps " + std::to_string(least));
   gdsr::BodyOptions bo;
   bo.fps = a.fps;
   bo.rest_blend_frames = a.rest_blend_frames;
@@ -238,7 +242,7 @@ void run_make(const MakeArgs& a) {
   sim::SimParams params;
   if (a.substeps > 0) params.substeps = a.substeps;
   params.substep_travel = effective_substep_travel(a);
-  if (a.max_substeps > 0) params.max_substeps = a.max_substeps;
+  params.max_substeps = effective_max_substeps(a);
   if (a.iterations > 0) params.iterations = a.iterations;
   if (a.stretch_passes > 0) params.stretch_passes = a.stretch_passes;
   if (a.settle_frames >= 0) params.settle_frames = a.settle_frames;
@@ -426,8 +430,7 @@ bool built_and_valid(const std::string& dir, const MakeArgs& a, std::string& why
       return false;
     }
     if (!same(sp.value("substep_travel_m", 0.0), effective_substep_travel(a)) ||
-        (effective_substep_travel(a) > 0 &&
-         sp.value("max_substeps", 0) != (a.max_substeps > 0 ? a.max_substeps : sim::SimParams().max_substeps))) {
+        (effective_substep_travel(a) > 0 && sp.value("max_substeps", 0) != effective_max_substeps(a))) {
       why = "built with other adaptive substeps";
       return false;
     }

@@ -817,8 +817,7 @@ int ClothSolver::substeps_for(double dt) const {
   if (!(wanted > n)) return n;  // NaN velocities fail after the step
   // Multiples of a quarter of `substeps`: the implicit bending solve keeps a factorisation per substep length.
   const int quantum = std::max(1, n / 4);
-  const double steps = std::ceil((wanted - n) / quantum);
-  return std::min(p_.max_substeps, n + static_cast<int>(std::min<double>(steps, p_.max_substeps)) * quantum);
+  return static_cast<int>(std::min<double>(p_.max_substeps, n + std::ceil((wanted - n) / quantum) * quantum));
 }
 
 void ClothSolver::step(const Points3& body_from, const Points3& body_to, double dt) {
