@@ -6,6 +6,7 @@
 #include "gdsr/geometry/triangle.hpp"
 
 #include <embree3/rtcore.h>
+#include <omp.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -287,10 +288,12 @@ struct SelfCollision::Embree {
 
 namespace {
 // Runs job(0) .. job(n - 1) on two threads, each job taken by the first thread free (the
-// largest first, if the caller lists them so); rethrows the first exception a job threw.
+// largest first, if the caller lists them so); on one when OpenMP is limited to one (ctest runs
+// two tests side by side with OMP_NUM_THREADS=1, and two threads each spin-waited for a core:
+// the kneel test took 148 s in CI against 28 s alone); rethrows the first exception a job threw.
 template <class Job> void run_jobs(int n, Job&& job) {
   std::exception_ptr error;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(2)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(2) if (omp_get_max_threads() > 1)
   for (int k = 0; k < n; ++k) {
     try {
       job(k);
@@ -506,7 +509,7 @@ void SelfCollision::redetect(const Points3& x, const Points3& start, const Point
 
 void SelfCollision::sort_pairs() {
   const int nv = static_cast<int>(tangled_.size()), ne = static_cast<int>(edges_.size());
-#pragma omp parallel sections num_threads(2)
+#pragma omp parallel sections num_threads(2) if (omp_get_max_threads() > 1)
   {
 #pragma omp section
     sort_unique_pairs(

@@ -212,7 +212,7 @@ int SelfCollision::project(Points3& x, const std::vector<double>& winv, double t
   speculated_ee_.resize(nee);
   pushes_vt_.resize(nvt);
   pushes_ee_.resize(nee);
-#pragma omp parallel num_threads(2)
+#pragma omp parallel num_threads(2) if (omp_get_max_threads() > 1)  // (also checked above)
   {
     PairPush push;
 #pragma omp for schedule(static) nowait

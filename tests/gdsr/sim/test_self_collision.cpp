@@ -404,6 +404,53 @@ TEST_CASE("self-collision: redetect finds the moved vertices' pairs again and ke
   });
 }
 
+TEST_CASE("self-collision: detect and redetect find the same pairs on one thread as on two") {
+  // The broad phase's collides are jobs shared by two threads when OpenMP allows two, and run in
+  // turn when it allows one (ctest's OMP_NUM_THREADS=1): the pairs, their order, the crossings
+  // found by the tangle test and the sides the pairs remember (seen through a projection pass)
+  // must not depend on which.
+  const CrumpledSheets sheets(5);
+  const auto& m = sheets.m;
+  const int nv = static_cast<int>(m.V.rows());
+  const double thickness = 0.005, slack = 0.001;
+  const Points3 start = sheets.x + 0.5 * sheets.motion, rest = 0.5 * sheets.motion;  // halfway, for redetect
+  struct Found {
+    std::vector<std::array<int, 2>> vt, ee, vt_re, ee_re;
+    int crossing = 0;
+    Points3 pushed;
+  };
+  auto found = [&](int threads) {
+    const sim::OmpThreads scope(threads);
+    REQUIRE(omp_get_max_threads() == threads);
+    Found out;
+    sim::SelfCollision sc(m.F, nv);
+    sc.detect(sheets.x, sheets.motion, slack, thickness, /*tangle_test=*/true);
+    out.vt = sc.vertex_triangle_pairs();
+    out.ee = sc.edge_edge_pairs();
+    out.crossing = sc.num_intersecting_pairs();
+    std::vector<char> moved(nv, 0);
+    for (int v = 0; v < nv; v += 7) moved[v] = 1;
+    sc.redetect(start, start, rest, moved, 0.5, slack, thickness);
+    out.vt_re = sc.vertex_triangle_pairs();
+    out.ee_re = sc.edge_edge_pairs();
+    out.pushed = start;
+    sc.project(out.pushed, std::vector<double>(nv, 1.0), thickness);
+    return out;
+  };
+  const Found one = found(1), two = found(2);
+  MESSAGE(one.vt.size() << " vertex-triangle and " << one.ee.size() << " edge-edge pairs, " << one.crossing
+                        << " crossings");
+  CHECK(one.vt.size() > 1000);
+  CHECK(one.ee.size() > 1000);
+  CHECK(one.vt == two.vt);
+  CHECK(one.ee == two.ee);
+  CHECK(one.crossing == two.crossing);
+  CHECK(one.vt_re == two.vt_re);
+  CHECK(one.ee_re == two.ee_re);
+  CHECK((one.pushed - start).cwiseAbs().maxCoeff() > 0);  // the pass pushed something
+  CHECK((one.pushed - two.pushed).cwiseAbs().maxCoeff() == 0.0);
+}
+
 TEST_CASE("self-collision: redetecting the vertices that left their slack gives the full detection's simulation") {
   // The sheet dropped onto a clamped sheet (below), with SimParams::self_redetect on and off:
   // the same positions to the bit, in fewer full detections.
