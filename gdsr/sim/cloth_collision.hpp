@@ -23,6 +23,23 @@ struct SurfaceHit {
   double signed_distance = 0;              // > 0 outside, < 0 inside (metres)
 };
 
+// The faces one query point must test: those whose boxes, in the pose queried, lie within the
+// search radius, ascending, each with its closest point once a query has needed it. One set
+// serves several queries at the same point, pose and radius (the solver's: the closest face, then
+// the closest of another body part), each face's exact test made once.
+struct SurfaceCandidates {
+  struct Face {
+    int face;
+    double gap2;          // squared distance from the point to the face's box, m^2
+    bool tested = false;  // bary, point and d2 below are set
+    gdsr::Vec3 bary, point;
+    double d2;  // squared distance to the closest point, m^2
+  };
+  gdsr::Vec3 x = gdsr::Vec3::Zero();
+  double radius = 0;
+  std::vector<Face> faces;
+};
+
 class SurfaceGrid {
  public:
   // Grid for triangles F over poses V0 and V1 (and any blend between them); cell in metres.
@@ -32,6 +49,11 @@ class SurfaceGrid {
   // when it is given.
   SurfaceHit closest(const gdsr::Vec3& x, const gdsr::Points3& V, double radius,
                      const std::function<bool(int)>& accept = {}) const;
+  // The same query in two steps: the candidates for x in pose V within radius, then the closest
+  // among them (accepted by `accept`, if given); closest(c, V, accept) after candidates(x, V,
+  // radius, c) gives closest(x, V, radius, accept) bit for bit, as often as it is asked.
+  void candidates(const gdsr::Vec3& x, const gdsr::Points3& V, double radius, SurfaceCandidates& out) const;
+  SurfaceHit closest(SurfaceCandidates& c, const gdsr::Points3& V, const std::function<bool(int)>& accept = {}) const;
   bool empty() const { return faces_.empty(); }
 
  private:

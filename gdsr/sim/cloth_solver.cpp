@@ -399,49 +399,54 @@ void ClothSolver::refresh_contacts(const Points3& body_now, double h) {
         return true;
       };
     };
-#pragma omp parallel for schedule(dynamic, 256)
-    for (int v = 0; v < nv; ++v) {
-      if (winv_[v] == 0) {  // a pin: only a part it was not dressed on may press it (pin_yield_rate)
-        if (pin_of_.empty() || pin_of_[v] < 0 || !(pin_room_[pin_of_[v]] > 0)) continue;
-        const SurfaceHit b = grid_.closest(x_.row(v).transpose(), body_now, r, foreign_to(home_.row(v).transpose()));
-        if (b.face >= 0) add(v, b);
-        continue;
+#pragma omp parallel
+    {
+      SurfaceCandidates near;  // the faces within r of the vertex: its two queries below share them
+#pragma omp for schedule(dynamic, 256)
+      for (int v = 0; v < nv; ++v) {
+        if (winv_[v] == 0) {  // a pin: only a part it was not dressed on may press it (pin_yield_rate)
+          if (pin_of_.empty() || pin_of_[v] < 0 || !(pin_room_[pin_of_[v]] > 0)) continue;
+          const SurfaceHit b = grid_.closest(x_.row(v).transpose(), body_now, r, foreign_to(home_.row(v).transpose()));
+          if (b.face >= 0) add(v, b);
+          continue;
+        }
+        const Vec3 x = x_.row(v).transpose();
+        // Nothing within the fixed radius: farther, a surface the vertex approaches fast enough to be
+        // within that radius by the next refresh (the body's own motion is left to the radius).
+        grid_.candidates(x, body_now, r, near);
+        SurfaceHit a = grid_.closest(near, body_now);
+        const double travel = until_next * v_.row(v).norm();
+        if (a.face < 0 && travel > 0) {
+          a = grid_.closest(x, body_now, r + travel);
+          if (a.face >= 0 && a.signed_distance + until_next * v_.row(v).dot(a.normal) > r) continue;
+        }
+        if (a.face < 0) continue;
+        const Vec3 ra = bary_point(body_rest_, bodyF_, a.face, a.bary);
+        const bool dressed = home_.row(v).allFinite();
+        // Lost inside a part it was not dressed on and no cloth was dressed on (limbs_pass_through,
+        // dressed_radius): a hand, not the leg a trouser leg hangs on, nor the thigh that a kneel
+        // closes onto the calf with the trouser in the crook.
+        if (a.signed_distance <= -p_.max_push && anchored_[v] &&
+            (!dressed || (ra - home_.row(v).transpose()).squaredNorm() > sep2) && !under_garment(a.face))
+          pierced[v] = {v, a.face, a.bary};
+        // A second body part within reach (far from the first one in the first pose): the cloth
+        // may be pinched between them (a hand pressing a skirt onto the hip). Both contacts
+        // apply; the part the vertex was dressed on comes last, so it wins when they conflict.
+        if (!dressed) {  // dressed nowhere near the body: nothing to prefer
+          add(v, a);
+          continue;
+        }
+        const SurfaceHit b = grid_.closest(near, body_now, foreign_to(ra));
+        if (b.face < 0) {
+          add(v, a);
+          continue;
+        }
+        const Vec3 home = home_.row(v).transpose();
+        const Vec3 rb = bary_point(body_rest_, bodyF_, b.face, b.bary);
+        const bool a_home = (ra - home).squaredNorm() <= (rb - home).squaredNorm();
+        add(v, a_home ? b : a);
+        add(v, a_home ? a : b);
       }
-      const Vec3 x = x_.row(v).transpose();
-      // Nothing within the fixed radius: farther, a surface the vertex approaches fast enough to be
-      // within that radius by the next refresh (the body's own motion is left to the radius).
-      SurfaceHit a = grid_.closest(x, body_now, r);
-      const double travel = until_next * v_.row(v).norm();
-      if (a.face < 0 && travel > 0) {
-        a = grid_.closest(x, body_now, r + travel);
-        if (a.face >= 0 && a.signed_distance + until_next * v_.row(v).dot(a.normal) > r) continue;
-      }
-      if (a.face < 0) continue;
-      const Vec3 ra = bary_point(body_rest_, bodyF_, a.face, a.bary);
-      const bool dressed = home_.row(v).allFinite();
-      // Lost inside a part it was not dressed on and no cloth was dressed on (limbs_pass_through,
-      // dressed_radius): a hand, not the leg a trouser leg hangs on, nor the thigh that a kneel
-      // closes onto the calf with the trouser in the crook.
-      if (a.signed_distance <= -p_.max_push && anchored_[v] &&
-          (!dressed || (ra - home_.row(v).transpose()).squaredNorm() > sep2) && !under_garment(a.face))
-        pierced[v] = {v, a.face, a.bary};
-      // A second body part within reach (far from the first one in the first pose): the cloth
-      // may be pinched between them (a hand pressing a skirt onto the hip). Both contacts
-      // apply; the part the vertex was dressed on comes last, so it wins when they conflict.
-      if (!dressed) {  // dressed nowhere near the body: nothing to prefer
-        add(v, a);
-        continue;
-      }
-      const SurfaceHit b = grid_.closest(x, body_now, r, foreign_to(ra));
-      if (b.face < 0) {
-        add(v, a);
-        continue;
-      }
-      const Vec3 home = home_.row(v).transpose();
-      const Vec3 rb = bary_point(body_rest_, bodyF_, b.face, b.bary);
-      const bool a_home = (ra - home).squaredNorm() <= (rb - home).squaredNorm();
-      add(v, a_home ? b : a);
-      add(v, a_home ? a : b);
     }
     if (p_.limbs_pass_through) pass_limbs_through(pierced, found, count);
     for (int v = 0; v < nv; ++v)

@@ -1,7 +1,7 @@
 // The body's closest-point grid (gdsr/sim/cloth_collision.hpp) against a brute-force search
 // over every face: the grid only prunes (cells, then face boxes), so it must give the same
 // face, point, normal and signed distance, bit for bit, for any pose between the two it was
-// built for, with and without a face filter.
+// built for, with and without a face filter, in one step or two (candidates, then closest).
 #include <doctest/doctest.h>
 
 #include "gdsr/geometry/triangle.hpp"
@@ -71,11 +71,27 @@ TEST_CASE("cloth collision: the body grid finds the same closest point as every 
       const Vec3 v = Vmid.row(static_cast<int>(u(rng) * (Vmid.rows() - 1))).transpose();
       x = v + 0.04 * Vec3(2 * u(rng) - 1, 2 * u(rng) - 1, 2 * u(rng) - 1);
     }
+    // One candidate set for both queries, asked in turn (as the solver does) and again in the
+    // other order: its faces' closest points, computed by the first query that needs them, serve
+    // the next one.
+    sim::SurfaceCandidates shared, reversed;
+    grid.candidates(x, Vmid, radius, shared);
+    grid.candidates(x, Vmid, radius, reversed);
+    const sim::SurfaceHit reversed_third = grid.closest(reversed, Vmid, every_third);
     for (const auto* accept : {static_cast<const std::function<bool(int)>*>(nullptr), &every_third}) {
       const std::function<bool(int)> filter = accept ? *accept : std::function<bool(int)>();
       const sim::SurfaceHit g = grid.closest(x, Vmid, radius, filter);
       const sim::SurfaceHit b = brute_force(x, body.F, Vmid, radius, filter);
+      const sim::SurfaceHit s = grid.closest(shared, Vmid, filter);
+      const sim::SurfaceHit r = accept ? reversed_third : grid.closest(reversed, Vmid, filter);
       REQUIRE(g.face == b.face);
+      for (const sim::SurfaceHit* two_step : {&s, &r}) {
+        REQUIRE(two_step->face == b.face);
+        if (b.face < 0) continue;
+        CHECK(two_step->point == b.point);
+        CHECK(two_step->normal == b.normal);
+        CHECK(two_step->signed_distance == b.signed_distance);
+      }
       if (b.face < 0) continue;
       CHECK(g.point == b.point);
       CHECK(g.bary == b.bary);
