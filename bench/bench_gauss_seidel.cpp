@@ -1,8 +1,8 @@
 // The cloth solver's Gauss-Seidel work on one thread and on two, with the same result: one
 // stretch pass over the edges of the 10 mm long-sleeve t-shirt (15.2k vertices, 45k edges on
 // the CMU 01_01 body), in edge order on one thread and by GaussSeidelSchedule on two; and the
-// implicit bending step (ImplicitBending::solve: its three columns' substitution sweeps) on one
-// thread and two; one self-contact pass (SelfCollision::project) on one thread and two. The time
+// implicit bending step (ImplicitBending::solve: Jacobi sweeps or the factorisation's
+// substitutions) on one thread and two; one self-contact pass (SelfCollision::project) on one thread and two. The time
 // is per pass or per solve. Counters: edges, levels, and `same` = 1 when the two-thread positions
 // equal the one-thread ones bit for bit after every pass timed.
 // Run with nothing else on the machine: a thread that waits for the other one's edges loses
@@ -95,44 +95,93 @@ void BM_StretchPass(benchmark::State& st) {
 }
 BENCHMARK(BM_StretchPass)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
+// The 10 mm t-shirt's hinges as the cloth solver makes them (cotangent weights of the pattern's
+// triangles, stiffness = the solver's default modulus 2e-6 N m over the two faces' area; masses
+// of the default 0.08 kg/m^2), its pinned vertices fixed. Args: threads, substeps per 1/30 s
+// frame (h), method (0: the solver's choice, Jacobi where the mass dominates; 1: always the
+// factorisation). Counters: ratio (ImplicitBending::dominance_ratio: <= 0.75 takes Jacobi),
+// iterations (Jacobi sweeps of a solve, 0 for the factorisation) and err_m, the largest
+// coordinate difference between the two methods' results, in metres.
+struct Hinges {
+  std::vector<sim::BendStencil> bends;
+  std::vector<double> mass;
+  std::vector<char> fixed;
+};
+const Hinges& hinges() {
+  static const Hinges hg = [] {
+    const Shirt& s = shirt();
+    const auto& m = s.g.mesh;
+    const int nv = static_cast<int>(m.V.rows());
+    Hinges h{{}, std::vector<double>(nv, 0.0), std::vector<char>(nv, 0)};
+    auto uv = [&](int f, int vert) {  // the pattern (UV, metres) position of a face's corner
+      for (int k = 0; k < 3; ++k)
+        if (m.F(f, k) == vert) return Eigen::RowVector2d(m.UV.row(m.FUV(f, k)));
+      return Eigen::RowVector2d(0, 0);
+    };
+    auto area = [&](int f) {
+      const Eigen::RowVector2d a = uv(f, m.F(f, 1)) - uv(f, m.F(f, 0)), b = uv(f, m.F(f, 2)) - uv(f, m.F(f, 0));
+      return 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
+    };
+    auto cot = [&](int f, int o, int a, int b) {  // cotangent of face f's angle at o, between a and b
+      const Eigen::RowVector2d u = uv(f, a) - uv(f, o), w = uv(f, b) - uv(f, o);
+      return u.dot(w) / std::abs(u.x() * w.y() - u.y() * w.x());
+    };
+    std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> faces;  // edge -> (face, opposite vertex)
+    for (int f = 0; f < m.F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const int a = m.F(f, k), b = m.F(f, (k + 1) % 3), o = m.F(f, (k + 2) % 3);
+        faces[{std::min(a, b), std::max(a, b)}].push_back({f, o});
+        h.mass[a] += 0.08 * area(f) / 3;
+      }
+    for (const auto& [e, fo] : faces) {
+      if (fo.size() != 2) continue;
+      const int x0 = e.first, x1 = e.second, x2 = fo[0].second, x3 = fo[1].second;
+      const int f0 = fo[0].first, f1 = fo[1].first;
+      const double c01 = cot(f0, x0, x1, x2), c02 = cot(f1, x0, x1, x3), c03 = cot(f0, x1, x0, x2),
+                   c04 = cot(f1, x1, x0, x3);
+      h.bends.push_back({{x0, x1, x2, x3},
+                         {c03 + c04, c01 + c02, -c01 - c03, -c02 - c04},
+                         2e-6 / (area(fo[0].first) + area(fo[1].first))});
+    }
+    for (int v : s.g.pinned) h.fixed[v] = 1;
+    return h;
+  }();
+  return hg;
+}
+
 void BM_ImplicitBending(benchmark::State& st) {
   const Shirt& s = shirt();
-  const auto& m = s.g.mesh;
-  const int nv = static_cast<int>(m.V.rows());
-  // A hinge stencil on every interior edge (unit weights of the right signs; the solve's cost
-  // does not depend on them), 0.25 g per vertex, the pinned vertices fixed.
-  std::vector<std::vector<int>> opposite(s.edges.size());
-  std::map<std::pair<int, int>, int> id;
-  for (size_t e = 0; e < s.edges.size(); ++e) id[{s.edges[e][0], s.edges[e][1]}] = static_cast<int>(e);
-  for (int f = 0; f < m.F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = m.F(f, k), b = m.F(f, (k + 1) % 3), o = m.F(f, (k + 2) % 3);
-      opposite[id[{std::min(a, b), std::max(a, b)}]].push_back(o);
-    }
-  std::vector<sim::BendStencil> bends;
-  for (size_t e = 0; e < s.edges.size(); ++e)
-    if (opposite[e].size() == 2)
-      bends.push_back({{s.edges[e][0], s.edges[e][1], opposite[e][0], opposite[e][1]}, {1, 1, -1, -1}, 1e-4});
-  std::vector<char> fixed(nv, 0);
-  for (int v : s.g.pinned) fixed[v] = 1;
-  sim::ImplicitBending bending(nv, bends, std::vector<double>(nv, 2.5e-4), fixed);
-  gdsr::Points3 x = s.x;
-  bending.solve(1.0 / 600, x);  // factors
+  const Hinges& hg = hinges();
+  const int nv = static_cast<int>(s.x.rows());
+  const double h = 1.0 / (30 * st.range(1));
+  sim::ImplicitBending bending(nv, hg.bends, hg.mass, hg.fixed,
+                               st.range(2) ? 0.0 : sim::ImplicitBending::kJacobiMaxRatio);
+  sim::ImplicitBending factored(nv, hg.bends, hg.mass, hg.fixed, 0.0);
+  gdsr::Points3 x = s.x, ref = s.x;
+  bending.solve(h, x);  // factors, if it is to
+  factored.solve(h, ref);
   const int levels = omp_get_max_active_levels();
   for (auto _ : st) {
     x = s.x;
     if (st.range(0) == 2) {
-      bending.solve(1.0 / 600, x);
+      bending.solve(h, x);
     } else {  // nested in a region with nesting off: the solve's own region gets one thread
       omp_set_max_active_levels(1);
 #pragma omp parallel num_threads(2)
-      if (omp_get_thread_num() == 0) bending.solve(1.0 / 600, x);
+      if (omp_get_thread_num() == 0) bending.solve(h, x);
       omp_set_max_active_levels(levels);
     }
   }
   st.counters["vertices"] = nv;
+  st.counters["ratio"] = bending.dominance_ratio(h);
+  st.counters["iterations"] = bending.last_iterations();
+  st.counters["err_m"] = (x - ref).cwiseAbs().maxCoeff();
 }
-BENCHMARK(BM_ImplicitBending)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ImplicitBending)
+    ->ArgNames({"threads", "substeps", "factored"})
+    ->ArgsProduct({{1, 2}, {20, 40}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // One self-contact pass (SelfCollision::project) over two 1 m sheets at 10 mm (23k vertices)
 // 6 mm apart, uneven by up to 0.5 mm, detected at rest 5 mm thick (20 pairs per vertex); then

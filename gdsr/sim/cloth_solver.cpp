@@ -233,7 +233,7 @@ ClothSolver::ClothSolver(const Garment& g, const gdsr::Faces& body_F, const Poin
       stencils.push_back({{b.v[0], b.v[1], b.v[2], b.v[3]}, {b.K[0], b.K[1], b.K[2], b.K[3]}, 1.0 / b.compliance});
     std::vector<char> fixed(nv);
     for (int v = 0; v < nv; ++v) fixed[v] = winv_[v] == 0;
-    implicit_bending_ = std::make_unique<ImplicitBending>(nv, stencils, mass_, fixed);
+    implicit_bending_ = std::make_unique<ImplicitBending>(nv, stencils, mass_, fixed, p.bending_jacobi_max_ratio);
   }
   // Cloth that hangs from a pin: connected to one through the mesh (see overstretched_at).
   anchored_.assign(nv, 0);

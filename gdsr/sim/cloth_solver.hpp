@@ -314,7 +314,13 @@ namespace sim {
 //     bench/bench_cloth.cpp (40 frames of 01_01 from the settled drape, one thread): 20.4
 //     substeps a frame at 30 mm and 20 at 10 mm, the same figures as 20 fixed, CPU 0.063 against
 //     0.059 and 0.58 against 0.57 s a frame.
-inline constexpr int kSolverRevision = 32;
+// 33: the implicit bending step by Jacobi iteration (to 1e-12 m) where the mass dominates its
+//     matrix, instead of the factorisation's substitutions (sim/cloth_bending_solve.hpp): every
+//     LR solve, and HR ones from about 27 substeps a frame at 10 mm. Same equation, solved to
+//     rounding either way, so the change is in the last bits, which the chaos of contact then
+//     spreads. The t-shirt on walk 131_01 (2-2.5 s, 10 mm, 2 threads): the HR bending step 8.0 ->
+//     1.8 ms a solve (13.5 sweeps), 14.2 -> 3.2 s over the clip; HR 0.916 -> 0.741 s a frame.
+inline constexpr int kSolverRevision = 33;
 
 struct SimParams {
   int substeps = 20;                // per body frame (the least; see substep_travel)
@@ -608,6 +614,11 @@ struct SimParams {
                         // freezing the pairs' sides in the extra pass gives 77% and 93%); 3 passes: pants on 61_03
                         // HR 49%, LR 69%. At k = 2 the 30 mm pants on 61_03 are 100% clean at 1, 2 and 3 passes
   bool implicit_bending = true;   // bending by one linear solve per substep (sim/cloth_bending_solve.hpp)
+  // Its solve by Jacobi iteration where the mass dominates the matrix this much
+  // (ImplicitBending::dominance_ratio), else by the factorisation; 0: always the factorisation
+  // (revision 32's arithmetic: the scenario tests' control runs, hand-picked draws of a chaotic
+  // scene, are kept on it).
+  double bending_jacobi_max_ratio = ImplicitBending::kJacobiMaxRatio;
   int stretch_passes = 4;         // stretch (+ tether) passes per iteration: cheap (~1% of a substep each)
   bool tethers = true;            // long-range attachments to the pins (sim/cloth_tethers.hpp)
   double tether_stretch = 0.002;  // stretch a tether allows beyond the rest distance along the cloth (0.2%)
